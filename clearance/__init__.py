@@ -1,0 +1,62 @@
+"""clearance: planar mechanisms with revolute-joint clearance, simulated in MuJoCo.
+
+Importing this package is cheap: MuJoCo-dependent parts (`simulate`, `simulate_many`,
+`SimulationResult`) are imported on first use.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from clearance.model import (
+    STEEL,
+    Clearance,
+    ContactLaw,
+    Drive,
+    DriveKind,
+    Joint,
+    JointType,
+    Link,
+    Material,
+    Mechanism,
+    MotionLaw,
+    Output,
+    OutputKind,
+)
+
+__version__ = "0.1.0"
+
+_LAZY = {
+    "simulate": "clearance.simulation",
+    "simulate_many": "clearance.simulation",
+    "SimulationError": "clearance.simulation",
+    "SimulationResult": "clearance.results",
+    "ModelOptions": "clearance.options",
+    "ContactMode": "clearance.options",
+    "GeomType": "clearance.options",
+}
+
+__all__ = [
+    "STEEL",
+    "Clearance",
+    "ContactLaw",
+    "Drive",
+    "DriveKind",
+    "Joint",
+    "JointType",
+    "Link",
+    "Material",
+    "Mechanism",
+    "MotionLaw",
+    "Output",
+    "OutputKind",
+    *_LAZY,
+]
+
+
+def __getattr__(name: str) -> Any:
+    if name in _LAZY:
+        import importlib
+
+        return getattr(importlib.import_module(_LAZY[name]), name)
+    raise AttributeError(f"module 'clearance' has no attribute {name!r}")
