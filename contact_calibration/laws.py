@@ -1,0 +1,446 @@
+"""Normal and tangential contact force laws of a revolute clearance joint (pure NumPy).
+
+Every law here is a pure function of the penetration δ [m], its rate δ̇ [m/s] and, for the
+dissipative laws, the normal approach speed δ̇⁻ > 0 [m/s] recorded at contact onset and kept
+for the whole impact (REFERENCES.md section 1). No MuJoCo dependency: these functions are
+the independent reference the MuJoCo contact is calibrated against.
+
+Conventions:
+  * δ > 0 is penetration; for δ ≤ 0 every force is exactly 0.
+  * δ̇ > 0 while the bodies approach (compression), δ̇ < 0 while they separate.
+  * The normal force is a compressive magnitude [N], >= 0. Where a law's damping term would
+    make it negative (late in restitution, when the bodies separate faster than the surfaces
+    recover) it is clipped at 0: contact cannot pull (no adhesion).
+  * Inputs broadcast like NumPy arrays; a 0-d result is returned as a Python float.
+
+The dissipative laws share the form F = K δⁿ [1 + χ(cₑ) δ̇/δ̇⁻]; `hysteresis_factor`
+returns χ. Hu–Guo's factor is recalled, not checked: REFERENCES.md notes that one public
+code uses half of it. Ambrósio's friction thresholds v₀ = 1e-4 m/s and v₁ = 1e-3 m/s are
+recalled values (another code uses 1e-3 and 5e-2 m/s).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from clearance.model import Clearance, ContactLaw, Material
+
+__all__ = [
+    "bearing_stiffness",
+    "bearing_stiffness_from",
+    "hertz",
+    "lankarani_nikravesh",
+    "hunt_crossley",
+    "flores",
+    "gonthier",
+    "hu_guo",
+    "impact_law",
+    "hysteresis_factor",
+    "normal_force",
+    "ambrosio_friction",
+    "STIFFNESS_FORMULA",
+]
+
+STIFFNESS_FORMULA = "K = 4/(3(sigma_B + sigma_J)) sqrt(R_B R_J/(R_B - R_J)), sigma = (1 - nu^2)/E"
+"""The stiffness convention used by `bearing_stiffness` (record it with every output)."""
+
+Force = Any  # float for scalar inputs, np.ndarray otherwise
+
+
+def _out(x: np.ndarray) -> Force:
+    return float(x) if np.ndim(x) == 0 else x
+
+
+def _positive_scalar(name: str, value: float, unit: str) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be a positive finite number (got {value!r})") from None
+    if not math.isfinite(v) or v <= 0:
+        raise ValueError(f"{name} must be positive and finite (got {value!r} {unit})")
+    return v
+
+
+def _positive_array(name: str, value: ArrayLike, unit: str) -> np.ndarray:
+    a = np.asarray(value, dtype=float)
+    if not np.all(np.isfinite(a) & (a > 0)):
+        raise ValueError(
+            f"{name} must be positive and finite everywhere (got {value!r} {unit}); the "
+            "dissipative laws divide by the approach speed recorded at contact onset"
+        )
+    return a
+
+
+def _restitution(value: float, *, allow_zero: bool) -> float:
+    try:
+        e = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"restitution must be a number in (0, 1] (got {value!r})") from None
+    lo_ok = e >= 0 if allow_zero else e > 0
+    if not (math.isfinite(e) and lo_ok and e <= 1):
+        rng = "[0, 1]" if allow_zero else "(0, 1]"
+        raise ValueError(f"restitution must be in {rng} (got {value!r})")
+    return e
+
+
+def bearing_stiffness_from(
+    bearing_radius: float,
+    journal_radius: float,
+    bearing_material: Material,
+    journal_material: Material,
+) -> float:
+    """Contact stiffness of a journal inside a bearing.
+
+    K = 4 / (3 (σ_B + σ_J)) · sqrt(R_B R_J / (R_B − R_J)),  σ = (1 − ν²)/E: the sphere-type
+    formula used throughout the clearance-joint literature (REFERENCES.md section 1,
+    [checked]; see `STIFFNESS_FORMULA`). Steel, R_B = 10 mm gives 6.61e10 N/m^1.5 at
+    c = 0.5 mm.
+
+    Args:
+        bearing_radius: R_B [m], > 0.
+        journal_radius: R_J [m], 0 < R_J < R_B.
+        bearing_material: elastic material of the bearing.
+        journal_material: elastic material of the journal.
+
+    Returns:
+        K [N/m^1.5].
+
+    Raises:
+        ValueError: if a radius is not positive and finite or R_J >= R_B.
+    """
+    rb = _positive_scalar("bearing_radius", bearing_radius, "m")
+    rj = _positive_scalar("journal_radius", journal_radius, "m")
+    if rj >= rb:
+        raise ValueError(
+            f"journal_radius must be < bearing_radius = {rb} m (got {journal_radius!r} m)"
+        )
+    sigma = sum(
+        (1.0 - m.poisson_ratio**2) / m.youngs_modulus for m in (bearing_material, journal_material)
+    )
+    return 4.0 / (3.0 * sigma) * math.sqrt(rb * rj / (rb - rj))
+
+
+def bearing_stiffness(clearance: Clearance) -> float:
+    """Contact stiffness K [N/m^1.5] of a clearance joint (see `bearing_stiffness_from`).
+
+    Args:
+        clearance: the joint's clearance (radii and materials).
+
+    Returns:
+        K [N/m^1.5].
+    """
+    return bearing_stiffness_from(
+        clearance.bearing_radius,
+        clearance.journal_radius,
+        clearance.bearing_material,
+        clearance.journal_material,
+    )
+
+
+def _elastic(delta: ArrayLike, stiffness: float, exponent: float) -> np.ndarray:
+    d = np.maximum(np.asarray(delta, dtype=float), 0.0)
+    return stiffness * d**exponent
+
+
+def _dissipative(
+    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike,
+    stiffness: float, chi: float, exponent: float,
+) -> np.ndarray:
+    """K δⁿ [1 + χ δ̇/δ̇⁻] clipped at >= 0; no validation (callers validate once)."""
+    ratio = np.asarray(delta_dot, dtype=float) / approach_speed
+    return np.maximum(_elastic(delta, stiffness, exponent) * (1.0 + chi * ratio), 0.0)
+
+
+def hertz(delta: ArrayLike, *, stiffness: float, exponent: float = 1.5) -> Force:
+    """Hertz elastic contact F = K δⁿ (REFERENCES.md section 1, table row "Hertz").
+
+    Args:
+        delta: penetration δ [m], any shape; F = 0 where δ <= 0.
+        stiffness: K [N/m^n], > 0.
+        exponent: n [-], > 0 (1.5 for metals).
+
+    Returns:
+        Normal force [N], same shape as ``delta`` (float for scalars).
+
+    Raises:
+        ValueError: if stiffness or exponent is not positive and finite.
+    """
+    k = _positive_scalar("stiffness", stiffness, "N/m^n")
+    n = _positive_scalar("exponent", exponent, "")
+    return _out(_elastic(delta, k, n))
+
+
+def _law(
+    law: ContactLaw, delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike,
+    stiffness: float, restitution: float, exponent: float,
+) -> Force:
+    k = _positive_scalar("stiffness", stiffness, "N/m^n")
+    n = _positive_scalar("exponent", exponent, "")
+    v = _positive_array("approach_speed", approach_speed, "m/s")
+    chi = hysteresis_factor(law, restitution)
+    return _out(_dissipative(delta, delta_dot, v, k, chi, n))
+
+
+_ARGS_DOC = """
+    Args:
+        delta: penetration δ [m], any shape; F = 0 where δ <= 0.
+        delta_dot: penetration rate δ̇ [m/s] (> 0 approaching), broadcast with ``delta``.
+        approach_speed: δ̇⁻ [m/s], > 0: the normal approach speed at contact onset, kept for
+            the whole impact; scalar or broadcastable array.
+        stiffness: K [N/m^n], > 0.
+        restitution: coefficient of restitution cₑ [-], {rng}.
+        exponent: n [-], > 0 (1.5 for metals).
+
+    Returns:
+        Normal force [N] >= 0, broadcast shape of the inputs (float for scalars). The total
+        is clipped at 0 where the damping term would make it negative (no adhesion).
+
+    Raises:
+        ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
+            restitution is out of range.
+"""
+
+
+def lankarani_nikravesh(
+    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
+    stiffness: float, restitution: float, exponent: float = 1.5,
+) -> Force:
+    return _law(ContactLaw.LANKARANI_NIKRAVESH, delta, delta_dot, approach_speed,
+                stiffness, restitution, exponent)
+
+
+lankarani_nikravesh.__doc__ = """Lankarani–Nikravesh (1990): F = K δⁿ [1 + 3(1 − cₑ²)/4 · δ̇/δ̇⁻].
+
+    REFERENCES.md section 1 [checked]. Derived for cₑ close to 1 (good for cₑ ≳ 0.7); the
+    restitution of the impact it produces is slightly above cₑ (about 0.913 at cₑ = 0.9).
+""" + _ARGS_DOC.format(rng="[0, 1]")
+
+
+def hunt_crossley(
+    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
+    stiffness: float, restitution: float, exponent: float = 1.5,
+) -> Force:
+    return _law(ContactLaw.HUNT_CROSSLEY, delta, delta_dot, approach_speed,
+                stiffness, restitution, exponent)
+
+
+hunt_crossley.__doc__ = """Hunt–Crossley (1975): F = K δⁿ [1 + 3(1 − cₑ)/2 · δ̇/δ̇⁻].
+
+    REFERENCES.md section 1 [checked].
+""" + _ARGS_DOC.format(rng="[0, 1]")
+
+
+def flores(
+    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
+    stiffness: float, restitution: float, exponent: float = 1.5,
+) -> Force:
+    return _law(ContactLaw.FLORES, delta, delta_dot, approach_speed,
+                stiffness, restitution, exponent)
+
+
+flores.__doc__ = """Flores et al. (2011): F = K δⁿ [1 + 8(1 − cₑ)/(5cₑ) · δ̇/δ̇⁻].
+
+    REFERENCES.md section 1 [checked]; meant for the whole range of cₑ.
+""" + _ARGS_DOC.format(rng="(0, 1]")
+
+
+def gonthier(
+    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
+    stiffness: float, restitution: float, exponent: float = 1.5,
+) -> Force:
+    return _law(ContactLaw.GONTHIER, delta, delta_dot, approach_speed,
+                stiffness, restitution, exponent)
+
+
+gonthier.__doc__ = """Gonthier et al. (2004): F = K δⁿ [1 + (1 − cₑ²)/cₑ · δ̇/δ̇⁻].
+
+    REFERENCES.md section 1 [checked].
+""" + _ARGS_DOC.format(rng="(0, 1]")
+
+
+def hu_guo(
+    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
+    stiffness: float, restitution: float, exponent: float = 1.5,
+) -> Force:
+    return _law(ContactLaw.HU_GUO, delta, delta_dot, approach_speed,
+                stiffness, restitution, exponent)
+
+
+hu_guo.__doc__ = """Hu–Guo (2015): F = K δⁿ [1 + 3(1 − cₑ)/(2cₑ) · δ̇/δ̇⁻]. UNVERIFIED.
+
+    REFERENCES.md section 1 marks this factor [recalled]: one public code uses half of it.
+    Check it against the paper before relying on it.
+""" + _ARGS_DOC.format(rng="(0, 1]")
+
+
+def _step_cubic(delta: np.ndarray, d_max: float) -> np.ndarray:
+    z = np.clip(delta / d_max, 0.0, 1.0)
+    return z * z * (3.0 - 2.0 * z)
+
+
+def _impact(
+    delta: ArrayLike, delta_dot: ArrayLike, stiffness: float, exponent: float,
+    c_max: float, d_max: float,
+) -> np.ndarray:
+    d = np.asarray(delta, dtype=float)
+    damping = c_max * _step_cubic(d, d_max) * np.asarray(delta_dot, dtype=float)
+    f = np.maximum(_elastic(d, stiffness, exponent) + damping, 0.0)
+    return np.where(d > 0, f, 0.0)
+
+
+def impact_law(
+    delta: ArrayLike, delta_dot: ArrayLike, *, stiffness: float, exponent: float = 1.5,
+    c_max: float, d_max: float,
+) -> Force:
+    """MSC Adams IMPACT: F = max(0, K δⁿ + STEP(δ; 0, 0, d_max, C_max) δ̇) for δ > 0.
+
+    REFERENCES.md section 1 [checked]: STEP rises from 0 at δ = 0 to C_max at δ = d_max as
+    the cubic z²(3 − 2z), z = δ/d_max, and stays at C_max beyond. The max(0, ·) is the
+    commercial definition (IMPACT(x, x', x1, k, e, cmax, d) = max(0, k (x1 − x)^e −
+    STEP(x, x1 − d, cmax, x1, 0) x') in the Adams-derived solvers' manuals), so this law
+    too never pulls.
+
+    Args:
+        delta: penetration δ [m], any shape; F = 0 where δ <= 0.
+        delta_dot: penetration rate δ̇ [m/s] (> 0 approaching), broadcast with ``delta``.
+        stiffness: K [N/m^n], > 0.
+        exponent: n [-], > 0.
+        c_max: maximum damping coefficient C_max [N s/m], >= 0.
+        d_max: penetration d_max [m] > 0 at which full damping applies.
+
+    Returns:
+        Normal force [N] >= 0, broadcast shape of the inputs (float for scalars).
+
+    Raises:
+        ValueError: if an argument is out of range.
+    """
+    k = _positive_scalar("stiffness", stiffness, "N/m^n")
+    n = _positive_scalar("exponent", exponent, "")
+    c, d = _impact_params(c_max, d_max)
+    return _out(_impact(delta, delta_dot, k, n, c, d))
+
+
+def _impact_params(c_max: float | None, d_max: float | None) -> tuple[float, float]:
+    if c_max is None or d_max is None:
+        raise ValueError(
+            f"the IMPACT law needs c_max [N s/m] and d_max [m] (got c_max={c_max!r}, "
+            f"d_max={d_max!r})"
+        )
+    c = float(c_max)
+    if not (math.isfinite(c) and c >= 0):
+        raise ValueError(f"c_max must be >= 0 and finite (got {c_max!r} N s/m)")
+    return c, _positive_scalar("d_max", d_max, "m")
+
+
+_FACTORS = {
+    ContactLaw.LANKARANI_NIKRAVESH: (True, lambda e: 3.0 * (1.0 - e * e) / 4.0),
+    ContactLaw.HUNT_CROSSLEY: (True, lambda e: 1.5 * (1.0 - e)),
+    ContactLaw.FLORES: (False, lambda e: 8.0 * (1.0 - e) / (5.0 * e)),
+    ContactLaw.GONTHIER: (False, lambda e: (1.0 - e * e) / e),
+    ContactLaw.HU_GUO: (False, lambda e: 3.0 * (1.0 - e) / (2.0 * e)),
+}
+
+
+def hysteresis_factor(law: ContactLaw, restitution: float) -> float:
+    """The factor χ(cₑ) of F = K δⁿ [1 + χ δ̇/δ̇⁻] (REFERENCES.md section 1).
+
+    LN 3(1 − cₑ²)/4; Hunt–Crossley 3(1 − cₑ)/2; Flores 8(1 − cₑ)/(5cₑ); Gonthier
+    (1 − cₑ²)/cₑ; Hu–Guo 3(1 − cₑ)/(2cₑ) (recalled, unverified); Hertz 0.
+
+    Args:
+        law: the contact law.
+        restitution: cₑ [-]; in [0, 1] for LN and Hunt–Crossley, (0, 1] for the laws that
+            divide by cₑ; ignored for Hertz.
+
+    Returns:
+        χ [-] >= 0.
+
+    Raises:
+        ValueError: for IMPACT (its damping is C_max, not a hysteresis factor), a non-law,
+            or restitution out of range.
+    """
+    if not isinstance(law, ContactLaw):
+        raise ValueError(f"law must be a ContactLaw (got {law!r})")
+    if law is ContactLaw.HERTZ:
+        return 0.0
+    if law is ContactLaw.IMPACT:
+        raise ValueError("the IMPACT law has no hysteresis factor: its damping is set by c_max")
+    allow_zero, factor = _FACTORS[law]
+    return factor(_restitution(restitution, allow_zero=allow_zero))
+
+
+def normal_force(
+    law: ContactLaw, delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike | None,
+    *, stiffness: float, restitution: float, exponent: float = 1.5,
+    c_max: float | None = None, d_max: float | None = None,
+) -> Force:
+    """Normal contact force [N] of any `ContactLaw` (dispatch to the functions above).
+
+    Args:
+        law: the contact law.
+        delta: penetration δ [m], any shape; F = 0 where δ <= 0.
+        delta_dot: penetration rate δ̇ [m/s] (> 0 approaching).
+        approach_speed: δ̇⁻ [m/s] > 0 for the dissipative laws; ignored (may be None) for
+            HERTZ and IMPACT.
+        stiffness: K [N/m^n], > 0.
+        restitution: cₑ [-] (ignored by HERTZ and IMPACT).
+        exponent: n [-], > 0.
+        c_max: IMPACT's maximum damping [N s/m]; required for IMPACT only.
+        d_max: IMPACT's full-damping penetration [m]; required for IMPACT only.
+
+    Returns:
+        Normal force [N] >= 0, broadcast shape of the inputs (float for scalars).
+
+    Raises:
+        ValueError: on an unknown law, IMPACT without c_max/d_max, or bad arguments.
+    """
+    if not isinstance(law, ContactLaw):
+        raise ValueError(f"law must be a ContactLaw (got {law!r})")
+    if law is ContactLaw.HERTZ:
+        return hertz(delta, stiffness=stiffness, exponent=exponent)
+    if law is ContactLaw.IMPACT:
+        return impact_law(delta, delta_dot, stiffness=stiffness, exponent=exponent,
+                          c_max=c_max, d_max=d_max)  # type: ignore[arg-type]
+    return _law(law, delta, delta_dot, approach_speed, stiffness, restitution, exponent)
+
+
+def ambrosio_friction(
+    normal_force: ArrayLike, tangential_velocity: ArrayLike, *,
+    friction: float, v0: float = 1e-4, v1: float = 1e-3,
+) -> Force:
+    """Ambrósio's modified Coulomb friction: F_T = −μ c_d(|v_T|) F_N v_T/|v_T|.
+
+    REFERENCES.md section 2 [checked]: c_d = 0 for |v_T| <= v₀, (|v_T| − v₀)/(v₁ − v₀)
+    between, 1 above v₁. The defaults v₀ = 1e-4 m/s, v₁ = 1e-3 m/s are [recalled] values
+    (another code uses 1e-3 and 5e-2 m/s). The law cannot stick: c_d = 0 at rest.
+
+    Args:
+        normal_force: F_N [N] >= 0, any shape.
+        tangential_velocity: relative tangential velocity v_T [m/s], broadcast with F_N.
+        friction: Coulomb coefficient μ [-], >= 0.
+        v0: speed below which there is no friction [m/s], >= 0.
+        v1: speed above which full friction acts [m/s], > v0.
+
+    Returns:
+        Tangential force F_T [N], signed, opposing v_T (float for scalars).
+
+    Raises:
+        ValueError: if friction < 0, or not 0 <= v0 < v1 (all finite).
+    """
+    mu = float(friction)
+    if not (math.isfinite(mu) and mu >= 0):
+        raise ValueError(f"friction must be >= 0 and finite (got {friction!r})")
+    a, b = float(v0), float(v1)
+    if not (math.isfinite(a) and math.isfinite(b) and 0 <= a < b):
+        raise ValueError(f"v0 and v1 must satisfy 0 <= v0 < v1 [m/s] (got v0={v0!r}, v1={v1!r})")
+    return _out(_friction(normal_force, tangential_velocity, mu, a, b))
+
+
+def _friction(fn: ArrayLike, vt: ArrayLike, mu: float, v0: float, v1: float) -> np.ndarray:
+    v = np.asarray(vt, dtype=float)
+    cd = np.clip((np.abs(v) - v0) / (v1 - v0), 0.0, 1.0)
+    return -mu * cd * np.asarray(fn, dtype=float) * np.sign(v) + 0.0  # + 0.0: no -0.0
