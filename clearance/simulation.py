@@ -1,0 +1,251 @@
+"""`simulate`: run a mechanism in MuJoCo with `mujoco.rollout`, no Python per step.
+
+The run is stepped in chunks (bounded memory); after each chunk MuJoCo's warning counters,
+non-finite values and every journal's penetration are checked. A run that goes unstable
+stops with `SimulationError`, which names the time, the joint and a remedy, and carries the
+result computed up to the last good step.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Callable, Sequence
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from clearance.model import DriveKind, Mechanism
+from clearance.options import ContactParameters, ModelOptions
+from clearance.preparation import PreparedModel, prepare
+from clearance.readout import read_sensors
+
+__all__ = ["SimulationError", "simulate", "simulate_prepared", "default_duration"]
+
+
+class SimulationError(RuntimeError):
+    """A run diverged. ``partial`` holds the result up to the last good step (or None)."""
+
+    def __init__(self, message: str, partial=None, *, time: float | None = None, joint: str | None = None):
+        super().__init__(message)
+        self.partial = partial
+        self.time = time
+        self.joint = joint
+
+
+def default_duration(mechanism: Mechanism, revolutions: float = 3.0) -> float:
+    """``revolutions`` periods of the slowest prescribed drive [s] (1 s if none)."""
+    periods = [d.period for d in mechanism.drives if d.kind is not DriveKind.TORQUE]
+    return revolutions * max(periods) if periods else 1.0
+
+
+def _controls(mechanism: Mechanism, times: np.ndarray) -> np.ndarray:
+    """(len(times), n_drives) actuator controls: drive speed, or torque."""
+    out = np.empty((len(times), len(mechanism.drives)))
+    for k, d in enumerate(mechanism.drives):
+        out[:, k] = d.torque if d.kind is DriveKind.TORQUE else d.rate(times)
+    return out
+
+
+def _constant_controls(mechanism: Mechanism) -> bool:
+    return all(d.kind is not DriveKind.MOTION_LAW for d in mechanism.drives)
+
+
+def simulate(
+    mechanism: Mechanism,
+    *,
+    duration: float | None = None,
+    options: ModelOptions | None = None,
+    output_interval: float | None = None,
+    contact: dict[str, ContactParameters] | None = None,
+    progress: bool | Callable[[float], None] = False,
+    chunk_steps: int = 100_000,
+):
+    """Simulate a mechanism with clearance joints in MuJoCo.
+
+    Args:
+        mechanism: the mechanism.
+        duration: simulated time [s]; default 3 periods of the slowest drive.
+        options: numerical options (default `ModelOptions()`).
+        output_interval: interval of stored rows [s]; default every step. Peaks and event
+            statistics should be taken from full-rate data: keep the default for them.
+        contact: per-joint contact parameters overriding the contact mode's.
+        progress: True for a progress bar on stderr, or a callable receiving the fraction
+            done (0..1) after each chunk.
+        chunk_steps: steps per `mujoco.rollout` call (memory bound).
+
+    Returns:
+        SimulationResult (times, outputs, per-joint eccentricity / penetration / force,
+        drive angle / speed / torque, link poses, closure violation, metadata).
+
+    Raises:
+        ValueError: bad arguments (before any work).
+        AssemblyError: the mechanism cannot be assembled at t = 0.
+        TimeStepError: the time step is too large for the contact stiffness.
+        SimulationError: the run diverged (partial result attached).
+    """
+    options = options or ModelOptions()
+    if duration is None:
+        duration = default_duration(mechanism)
+    if not (isinstance(duration, (int, float)) and np.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be a positive number of seconds (got {duration!r})")
+    if output_interval is not None and not (np.isfinite(output_interval) and output_interval > 0):
+        raise ValueError(f"output_interval must be > 0 s (got {output_interval!r})")
+    if not isinstance(chunk_steps, int) or chunk_steps < 1:
+        raise ValueError(f"chunk_steps must be a positive integer (got {chunk_steps!r})")
+    prepared = prepare(mechanism, options, contact=contact)
+    return simulate_prepared(
+        prepared, duration=duration, output_interval=output_interval, progress=progress, chunk_steps=chunk_steps
+    )
+
+
+def simulate_prepared(
+    prepared: PreparedModel,
+    *,
+    duration: float,
+    output_interval: float | None = None,
+    progress: bool | Callable[[float], None] = False,
+    chunk_steps: int = 100_000,
+):
+    """Run an already prepared model (see `simulate` for the arguments)."""
+    from clearance.results import SimulationResult
+
+    model, mech = prepared.model, prepared.mechanism
+    h = model.opt.timestep
+    nstep = int(round(duration / h))
+    every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    spec_state = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state = np.empty(mujoco.mj_stateSize(model, spec_state))
+    mujoco.mj_getState(model, data, state, spec_state)
+    constant = _constant_controls(mech)
+    bar = _progress(progress, nstep)
+    parts: list[SimulationResult] = []
+    t0 = _time.perf_counter()
+    done = 0
+    while done < nstep:
+        n = min(chunk_steps, nstep - done)
+        times = (done + np.arange(n)) * h
+        ctrl = _controls(mech, times[:1] if constant else times)[None]
+        states, sens = rollout.rollout(model, data, state[None], ctrl, nstep=n)
+        states, sens = states[0], sens[0]
+        part = read_sensors(prepared, times, sens)
+        bad = _first_bad(prepared, data, part, states)
+        if bad is not None:
+            idx, joint, why, remedy = bad
+            keep = part.sliced(slice(0, idx))
+            parts.append(keep)
+            result = _finish(parts, every, prepared, t0, nstep_done=done + idx)
+            tb = float(times[min(idx, n - 1)])
+            raise SimulationError(
+                f"simulation diverged at t = {tb:.6g} s{f' at joint {joint!r}' if joint else ''}: {why}. "
+                f"Remedy: {remedy}. The result up to t = {tb:.6g} s is attached as .partial.",
+                result,
+                time=tb,
+                joint=joint,
+            )
+        parts.append(part)
+        state = states[-1]
+        done += n
+        bar(done)
+    bar(None)
+    return _finish(parts, every, prepared, t0, nstep_done=nstep)
+
+
+def _finish(parts, every, prepared: PreparedModel, t0: float, *, nstep_done: int):
+    from clearance.results import SimulationResult
+
+    if not parts:
+        return None
+    res = SimulationResult.concatenate(parts).decimated(every)
+    wall = _time.perf_counter() - t0
+    mech = prepared.mechanism
+    res.metadata = {
+        **prepared.metadata,
+        "solver": "mujoco",
+        "mechanism": mech.name,
+        "parameters": dict(mech.parameters),
+        "clearance_joints": [j.name for j in mech.clearance_joints],
+        "drives": [d.name for d in mech.drives],
+        "links": [lk.name for lk in mech.moving_links],
+        "steps": nstep_done,
+        "output_every_steps": every,
+        "wall_time_s": wall,
+        "steps_per_second": nstep_done / wall if wall > 0 else None,
+        "mujoco_version": mujoco.__version__,
+        "package_version": __import__("clearance").__version__,
+    }
+    return res
+
+
+def _first_bad(prepared: PreparedModel, data: mujoco.MjData, part, states: np.ndarray):
+    """(row index, joint, reason, remedy) of the first bad row, or None."""
+    fired = [mujoco.mjtWarning(i).name for i in range(mujoco.mjtWarning.mjNWARNING.value) if data.warning[i].number > 0]
+    n = len(part.times)
+    finite = np.isfinite(states).all(axis=1)
+    first_nan = int(np.argmin(finite)) if not finite.all() else n
+    worst = (n, None, None)
+    for name, jr in part.joints.items():
+        lim = prepared.sizing[name].penetration_limit
+        over = np.nonzero(~(jr.penetration <= lim))[0]
+        if len(over) and over[0] < worst[0]:
+            worst = (int(over[0]), name, float(np.nanmax(jr.penetration[over[0]:over[0] + 1])))
+    h = prepared.options.timestep
+    remedy = (
+        f"use a smaller time step (now {h:g} s, try {h / 2:g} s) or more bearing segments "
+        f"(ModelOptions(segments=...))"
+    )
+    if worst[1] is not None and worst[0] <= first_nan:
+        lim = prepared.sizing[worst[1]].penetration_limit
+        return worst[0], worst[1], (
+            f"the journal penetrated {worst[2] * 1e6:.3g} um into its bearing, beyond the bound "
+            f"{lim * 1e6:.3g} um (4 x the Hertz penetration of the expected hardest impact)"
+        ), remedy
+    if first_nan < n:
+        joint = next(iter(part.joints), None)
+        return max(first_nan - 1, 0), joint, "the state became non-finite (NaN or Inf)", remedy
+    if fired:
+        joint = next(iter(part.joints), None)
+        idx = max(n - 1, 0)
+        return idx, joint, f"MuJoCo raised warnings {fired} in this chunk", remedy
+    return None
+
+
+def _progress(progress, total: int):
+    if callable(progress):
+        return lambda done: progress(1.0 if done is None else done / total)
+    if not progress:
+        return lambda done: None
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, unit="step", unit_scale=True, desc="simulate", leave=False)
+
+    def update(done):
+        if done is None:
+            bar.close()
+        else:
+            bar.update(done - bar.n)
+
+    return update
+
+
+def simulate_many(
+    mechanisms: Sequence[Mechanism],
+    *,
+    duration: float | None = None,
+    options: ModelOptions | None = None,
+    output_interval: float | None = None,
+):
+    """Simulate several mechanisms one after another (see `simulate`).
+
+    Returns a list of results in input order; a diverged run yields its `SimulationError`
+    in place of a result so one bad point does not lose the others.
+    """
+    out = []
+    for m in mechanisms:
+        try:
+            out.append(simulate(m, duration=duration, options=options, output_interval=output_interval))
+        except SimulationError as err:
+            out.append(err)
+    return out

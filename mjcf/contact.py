@@ -1,0 +1,107 @@
+"""Contact parameters into a compiled model, and the effective mass at each bearing.
+
+MuJoCo's direct-mode solref ``(-S, -D)`` with a small constant impedance acts as a plain
+spring-damper of physical stiffness S / A_hat and damping D / A_hat per contact row, where
+A_hat is the row's approximate inverse inertia (the sum of the two bodies'
+``body_invweight0`` translational terms, frozen at qpos0) (MUJOCO_NOTES.md, re-measured in
+tests/test_mjcf.py). So a physical per-row stiffness k is written as S = k A_hat.
+"""
+
+from __future__ import annotations
+
+import mujoco
+import numpy as np
+
+from clearance.mjcf.spec import BuiltModel
+from clearance.options import ContactParameters
+
+__all__ = ["apply_contact", "row_inverse_weight", "effective_masses", "initial_velocity", "add_initial_keyframe"]
+
+
+def _body_id(model: mujoco.MjModel, name: str) -> int:
+    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+    return 0 if bid < 0 else bid  # ground -> world
+
+
+def row_inverse_weight(model: mujoco.MjModel, built: BuiltModel, joint: str) -> float:
+    """A_hat of the contact rows of a clearance joint [1/kg]."""
+    jb = _body_id(model, built.journal_body[joint])
+    bb = _body_id(model, built.bearing_body[joint])
+    return float(model.body_invweight0[jb, 0] + model.body_invweight0[bb, 0])
+
+
+def apply_contact(built: BuiltModel, model: mujoco.MjModel, params: dict[str, ContactParameters]) -> None:
+    """Write each clearance joint's per-row stiffness and damping into its pairs.
+
+    Updates both the compiled ``model`` (in place) and ``built.spec`` (for MJCF output).
+    """
+    pairs = {p.name: p for p in built.spec.pairs}
+    for joint, p in params.items():
+        a_hat = row_inverse_weight(model, built, joint)
+        solref = [-p.stiffness * a_hat, -p.damping * a_hat]
+        for i in range(built.rings[joint].segments):
+            name = f"{joint}__pair{i:03d}"
+            pid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, name)
+            model.pair_solref[pid] = solref
+            pairs[name].solref = solref
+
+
+def effective_masses(model: mujoco.MjModel, built: BuiltModel) -> dict[str, float]:
+    """Mass seen along the contact normal at each bearing at qpos0 [kg].
+
+    1 / (n^T J M^-1 J^T n) for the relative translation J of journal and bearing centres,
+    median over normal directions n. Equality constraints and the drive's actuator are not
+    included (the calibration issue measures the mass over a cycle with them).
+    """
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    out = {}
+    for joint in built.rings:
+        jac = np.zeros((2, 3, model.nv))
+        for k, site in enumerate((f"{joint}__journal", f"{joint}__bearing")):
+            sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, site)
+            mujoco.mj_jacSite(model, data, jac[k], None, sid)
+        jrel = (jac[0] - jac[1])[:2]
+        minv_jt = np.zeros((model.nv, 2))
+        for c in range(2):
+            x = jrel[c].copy()
+            mujoco.mj_solveM(model, data, x.reshape(1, -1), jrel[c].reshape(1, -1))
+            minv_jt[:, c] = x
+        a = jrel @ minv_jt
+        ang = np.linspace(0, np.pi, 36, endpoint=False)
+        n = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+        inv = np.einsum("ni,ij,nj->n", n, a, n)
+        out[joint] = float(np.median(1.0 / inv))
+    return out
+
+
+def initial_velocity(model: mujoco.MjModel, built: BuiltModel) -> np.ndarray:
+    """qvel (nv,) that gives every link its ideal-mechanism velocity at qpos0.
+
+    Solves J qvel = (v_x, v_y, omega) of every moving link's frame, stacked (a consistent
+    over-determined system; least squares makes it exact to round-off).
+    """
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    rows, rhs = [], []
+    names = [n for n in built.tree.order]
+    links_order = built.link_order
+    for name in names:
+        i = links_order.index(name)
+        bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+        jp, jr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+        mujoco.mj_jacBody(model, data, jp, jr, bid)
+        rows += [jp[0], jp[1], jr[2]]
+        rhs += list(built.qd0[3 * i : 3 * i + 3])
+    qvel, *_ = np.linalg.lstsq(np.array(rows), np.array(rhs), rcond=None)
+    return qvel
+
+
+def add_initial_keyframe(built: BuiltModel, model: mujoco.MjModel, ctrl: np.ndarray) -> None:
+    """Add keyframe ``initial`` (qpos0, ideal velocities, drive controls) to the spec."""
+    built.spec.add_key(
+        name="initial",
+        qpos=list(model.qpos0),
+        qvel=list(initial_velocity(model, built)),
+        ctrl=list(ctrl),
+    )

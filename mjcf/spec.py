@@ -1,0 +1,319 @@
+"""Mechanism -> `mujoco.MjSpec`: planar bodies, ring-segment bearings, pairs, drives, sensors.
+
+The body tree is built at the assembled t = 0 pose, so qpos0 is that pose; a keyframe
+``initial`` stores the ideal-mechanism velocities and the drive controls. Every body moves
+in the x-y plane through hinge-z and slide joints only. Inertials are explicit (geoms add no
+mass). Collisions happen only through explicit `<pair>` elements between each journal and
+its own bearing segments; every geom has contype = conaffinity = 0.
+
+Sensor names (read by `clearance.simulate`):
+  ``<link>__pos``, ``<link>__xaxis``: body frame position and x axis (world);
+  ``<joint>__ecc``: journal centre in the bearing frame;
+  ``<joint>__jvel``, ``<joint>__bvel``, ``<joint>__bangvel``, ``<joint>__bxaxis``: world
+  velocities of journal and bearing centres, bearing angular velocity and x axis;
+  ``<joint>__force``: net contact force between bearing and journal bodies (world);
+  ``<output>__pos``, ``__vel``, ``__acc`` (point outputs) or ``__angvel``, ``__angacc``;
+  ``<drive>__angle``, ``__speed``, ``__torque``; ``<cut>__closure`` for ideal cuts.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from clearance.kinematics import assemble, velocities
+from clearance.mjcf.bearing import RingGeometry, segment_centres
+from clearance.mjcf.tree import BodyTree, body_tree
+from clearance.model import DriveKind, Joint, JointType, Mechanism, OutputKind
+from clearance.options import GeomType, ModelOptions
+
+__all__ = ["BuiltModel", "build_spec", "drive_gear", "ring_geometry"]
+
+_OBJ = mujoco.mjtObj
+_SENS = mujoco.mjtSensor
+_THICK = 0.004  # half-thickness of visual link geoms and capsule segments along z [m]
+
+
+@dataclass
+class BuiltModel:
+    """A spec and what is needed to read its runs.
+
+    Attributes:
+        spec: the MjSpec.
+        tree: body tree (parents and cuts).
+        rings: clearance joint name -> ring geometry.
+        journal_body, bearing_body: clearance joint name -> body name.
+        drive_gear: drive name -> +1 or -1 (sign between hinge qpos and drive angle).
+        q0, qd0: assembled Cartesian coordinates and ideal velocities at t = 0.
+    """
+
+    spec: mujoco.MjSpec
+    tree: BodyTree
+    rings: dict[str, RingGeometry]
+    journal_body: dict[str, str]
+    bearing_body: dict[str, str]
+    drive_gear: dict[str, float]
+    q0: np.ndarray
+    qd0: np.ndarray
+    link_order: tuple[str, ...] = ()
+
+
+def ring_geometry(joint: Joint, segments: int, options: ModelOptions) -> RingGeometry:
+    """Ring geometry of a clearance joint for the chosen geoms and segment count."""
+    c = joint.clearance
+    n_pc = 2 if (options.journal_geom is GeomType.CAPSULE and options.segment_geom is GeomType.CAPSULE) else 1
+    return RingGeometry.make(
+        c.bearing_radius,
+        c.radial_clearance,
+        segments,
+        flat=options.segment_geom is GeomType.BOX,
+        contacts_per_pair=n_pc,
+    )
+
+
+def drive_gear(tree: BodyTree, mechanism: Mechanism) -> dict[str, float]:
+    """+1 when the driven joint's link_b is the child body, else -1."""
+    out = {}
+    for d in mechanism.drives:
+        j = mechanism.joint(d.joint)
+        child = j.link_b if j.link_b in tree.parent and tree.parent[j.link_b][1] is j else j.link_a
+        out[d.name] = 1.0 if child == j.link_b else -1.0
+    return out
+
+
+def _quat(theta: float) -> list[float]:
+    return [math.cos(theta / 2), 0.0, 0.0, math.sin(theta / 2)]
+
+
+def _to_frame(pose: np.ndarray, world: np.ndarray) -> np.ndarray:
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    d = world - pose[:2]
+    return np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
+
+
+def _sensor(spec, name, stype, objtype, objname, reftype=None, refname=""):
+    s = spec.add_sensor(name=name, type=stype, objtype=objtype, objname=objname)
+    if reftype is not None:
+        s.reftype = reftype
+        s.refname = refname
+    return s
+
+
+def build_spec(
+    mechanism: Mechanism,
+    options: ModelOptions,
+    segments: dict[str, int],
+) -> BuiltModel:
+    """Build the MuJoCo spec of a mechanism.
+
+    Args:
+        mechanism: the mechanism (its clearance joints get ring bearings).
+        options: numerical options (geoms, time step, integrator, impedance).
+        segments: clearance joint name -> segment count N.
+
+    Returns:
+        The spec and its reading aids. Contact pairs carry placeholder solref values until
+        `clearance.mjcf.contact.apply_contact` sets them.
+
+    Raises:
+        AssemblyError: the mechanism cannot be assembled at t = 0.
+        ValueError: a loop cannot be cut (see `body_tree`).
+    """
+    tree = body_tree(mechanism)
+    q0 = assemble(mechanism, 0.0)
+    qd0 = velocities(mechanism, q0, 0.0)
+    names = [lk.name for lk in mechanism.moving_links]
+    pose = {mechanism.ground: np.zeros(3)}
+    for i, n in enumerate(names):
+        pose[n] = q0[3 * i : 3 * i + 3]
+    links = {lk.name: lk for lk in mechanism.links}
+
+    spec = mujoco.MjSpec()
+    spec.modelname = mechanism.name
+    spec.compiler.degree = False
+    spec.option.timestep = options.timestep
+    spec.option.integrator = {
+        "implicitfast": mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
+        "euler": mujoco.mjtIntegrator.mjINT_EULER,
+        "implicit": mujoco.mjtIntegrator.mjINT_IMPLICIT,
+        "rk4": mujoco.mjtIntegrator.mjINT_RK4,
+    }[options.integrator]
+    spec.option.gravity = [mechanism.gravity[0], mechanism.gravity[1], 0.0]
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
+    spec.visual.global_.offwidth = 1280
+    spec.stat.extent = max(0.05, float(np.max(np.abs(q0.reshape(-1, 3)[:, :2])) * 2.5 + 0.05))
+
+    bodies = {mechanism.ground: spec.worldbody}
+    for child in tree.order:
+        par, joint = tree.parent[child]
+        lk = links[child]
+        rel = _to_frame(pose[par], pose[child][:2])
+        body = bodies[par].add_body(
+            name=child, pos=[rel[0], rel[1], 0.0], quat=_quat(pose[child][2] - pose[par][2])
+        )
+        body.mass = lk.mass
+        body.inertia = [lk.inertia, lk.inertia, lk.inertia]
+        body.ipos = [lk.com[0], lk.com[1], 0.0]
+        body.explicitinertial = True
+        bodies[child] = body
+        cpoint = joint.point_b if joint.link_b == child else joint.point_a
+        anchor = lk.point(cpoint)
+        if joint.kind is JointType.PRISMATIC:
+            th_a = pose[joint.link_a][2]
+            world_axis = np.array(
+                [math.cos(th_a) * joint.axis[0] - math.sin(th_a) * joint.axis[1],
+                 math.sin(th_a) * joint.axis[0] + math.cos(th_a) * joint.axis[1]]
+            )
+            c, s = math.cos(pose[child][2]), math.sin(pose[child][2])
+            ax = [c * world_axis[0] + s * world_axis[1], -s * world_axis[0] + c * world_axis[1], 0.0]
+            body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=ax, pos=[anchor[0], anchor[1], 0])
+        elif joint.clearance is None:
+            body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], pos=[anchor[0], anchor[1], 0])
+        else:
+            for k, ax in (("x", [1, 0, 0]), ("y", [0, 1, 0])):
+                body.add_joint(name=f"{joint.name}__{k}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=ax, pos=[anchor[0], anchor[1], 0])
+            body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], pos=[anchor[0], anchor[1], 0])
+        _visual_link(body, lk)
+
+    # ideal cuts -> connect equalities
+    tc = options.closure_timeconst if options.closure_timeconst is not None else 2 * options.timestep
+    for j in tree.ideal_cuts:
+        pa = links[j.link_a].point(j.point_a)
+        pb = links[j.link_b].point(j.point_b)
+        eq = spec.add_equality(
+            name=j.name, type=mujoco.mjtEq.mjEQ_CONNECT, objtype=_OBJ.mjOBJ_BODY,
+            name1=j.link_a if j.link_a != mechanism.ground else "world",
+            name2=j.link_b if j.link_b != mechanism.ground else "world",
+        )
+        eq.data[:3] = [pa[0], pa[1], 0.0]
+        eq.solref = [tc, 1.0]
+        _site(bodies[j.link_a], f"{j.name}__a", pa)
+        _site(bodies[j.link_b], f"{j.name}__b", pb)
+        _sensor(spec, f"{j.name}__closure", _SENS.mjSENS_FRAMEPOS, _OBJ.mjOBJ_SITE, f"{j.name}__b", _OBJ.mjOBJ_SITE, f"{j.name}__a")
+
+    rings, jbody, bbody = {}, {}, {}
+    for j in mechanism.clearance_joints:
+        c = j.clearance
+        jl = c.journal_link
+        bl = j.link_b if jl == j.link_a else j.link_a
+        jp = links[jl].point(j.point_a if jl == j.link_a else j.point_b)
+        bp = links[bl].point(j.point_a if bl == j.link_a else j.point_b)
+        ring = ring_geometry(j, segments[j.name], options)
+        rings[j.name], jbody[j.name], bbody[j.name] = ring, jl, bl
+        _journal_and_bearing(spec, bodies[jl], bodies[bl], j.name, jp, bp, ring, options, c.friction)
+        _site(bodies[jl], f"{j.name}__journal", jp)
+        _site(bodies[bl], f"{j.name}__bearing", bp)
+        _sensor(spec, f"{j.name}__ecc", _SENS.mjSENS_FRAMEPOS, _OBJ.mjOBJ_SITE, f"{j.name}__journal", _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
+        _sensor(spec, f"{j.name}__jvel", _SENS.mjSENS_FRAMELINVEL, _OBJ.mjOBJ_SITE, f"{j.name}__journal")
+        _sensor(spec, f"{j.name}__bvel", _SENS.mjSENS_FRAMELINVEL, _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
+        _sensor(spec, f"{j.name}__bangvel", _SENS.mjSENS_FRAMEANGVEL, _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
+        _sensor(spec, f"{j.name}__bxaxis", _SENS.mjSENS_FRAMEXAXIS, _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
+        s = _sensor(spec, f"{j.name}__force", _SENS.mjSENS_CONTACT, _OBJ.mjOBJ_BODY,
+                    bl if bl != mechanism.ground else "world", _OBJ.mjOBJ_BODY,
+                    jl if jl != mechanism.ground else "world")
+        s.intprm[:3] = [2, 3, 1]  # data = force, reduce = netforce, num = 1
+
+    for n in names:
+        _sensor(spec, f"{n}__pos", _SENS.mjSENS_FRAMEPOS, _OBJ.mjOBJ_BODY, n)
+        _sensor(spec, f"{n}__xaxis", _SENS.mjSENS_FRAMEXAXIS, _OBJ.mjOBJ_BODY, n)
+
+    for o in mechanism.outputs:
+        if o.kind is OutputKind.ANGLE:
+            _sensor(spec, f"{o.name}__angvel", _SENS.mjSENS_FRAMEANGVEL, _OBJ.mjOBJ_BODY, o.link)
+            _sensor(spec, f"{o.name}__angacc", _SENS.mjSENS_FRAMEANGACC, _OBJ.mjOBJ_BODY, o.link)
+        else:
+            _site(bodies[o.link], f"{o.name}__site", links[o.link].point(o.point))
+            for suffix, st in (("pos", _SENS.mjSENS_FRAMEPOS), ("vel", _SENS.mjSENS_FRAMELINVEL), ("acc", _SENS.mjSENS_FRAMELINACC)):
+                _sensor(spec, f"{o.name}__{suffix}", st, _OBJ.mjOBJ_SITE, f"{o.name}__site")
+
+    gears = drive_gear(tree, mechanism)
+    for d in mechanism.drives:
+        act = spec.add_actuator(name=d.name, target=d.joint, trntype=mujoco.mjtTrn.mjTRN_JOINT)
+        act.gear[0] = gears[d.name]
+        if d.kind is DriveKind.TORQUE:
+            act.set_to_motor()
+        else:
+            act.set_to_velocity(kv=_drive_gain(mechanism, options))
+        _sensor(spec, f"{d.name}__angle", _SENS.mjSENS_JOINTPOS, _OBJ.mjOBJ_JOINT, d.joint)
+        _sensor(spec, f"{d.name}__speed", _SENS.mjSENS_JOINTVEL, _OBJ.mjOBJ_JOINT, d.joint)
+        _sensor(spec, f"{d.name}__torque", _SENS.mjSENS_ACTUATORFRC, _OBJ.mjOBJ_ACTUATOR, d.name)
+
+    return BuiltModel(spec, tree, rings, jbody, bbody, gears, q0, qd0, tuple(names))
+
+
+def _drive_gain(mechanism: Mechanism, options: ModelOptions) -> float:
+    """Velocity-actuator gain kv [N m s/rad].
+
+    implicitfast integrates the actuator's damping implicitly, so a large kv is stable.
+    kv = 1e3 * (sum of link inertias about their pivots) / h makes the speed error of a
+    torque tau equal tau / kv: under 1e-5 relative at 5000 rpm with 500 N m for the
+    default slider-crank (1e3 * ~1e-4 kg m^2 / 1e-6 s = 1e5).
+    """
+    inertia = sum(lk.inertia + lk.mass * (lk.com[0] ** 2 + lk.com[1] ** 2) for lk in mechanism.moving_links)
+    return 1e3 * max(inertia, 1e-6) / options.timestep
+
+
+def _site(body, name: str, p: tuple[float, float]) -> None:
+    body.add_site(name=name, pos=[p[0], p[1], 0.0], size=[0.001, 0, 0], group=3)
+
+
+def _visual_link(body, link) -> None:
+    pts = list(link.points.values())
+    rgba = [0.55, 0.6, 0.7, 1.0]
+    kw = dict(contype=0, conaffinity=0, group=1, rgba=rgba, mass=0)
+    if len(pts) == 1:
+        body.add_geom(type=mujoco.mjtGeom.mjGEOM_BOX, size=[0.012, 0.008, _THICK], pos=[pts[0][0], pts[0][1], 0], **kw)
+        return
+    for i in range(len(pts)):
+        for k in range(i + 1, len(pts)):
+            a, b = pts[i], pts[k]
+            if math.hypot(b[0] - a[0], b[1] - a[1]) < 1e-9:
+                continue
+            body.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[_THICK / 2, 0, 0],
+                          fromto=[a[0], a[1], -_THICK, b[0], b[1], -_THICK], **kw)
+
+
+def _geom_type(g: GeomType) -> int:
+    return {
+        GeomType.SPHERE: mujoco.mjtGeom.mjGEOM_SPHERE,
+        GeomType.CAPSULE: mujoco.mjtGeom.mjGEOM_CAPSULE,
+        GeomType.BOX: mujoco.mjtGeom.mjGEOM_BOX,
+        GeomType.CYLINDER: mujoco.mjtGeom.mjGEOM_CYLINDER,
+    }[g]
+
+
+def _journal_and_bearing(spec, jbody, bbody, name, jp, bp, ring: RingGeometry, options: ModelOptions, friction: float) -> None:
+    nocol = dict(contype=0, conaffinity=0)
+    jg = options.journal_geom
+    size = [ring.journal_radius, _THICK, 0] if jg is not GeomType.SPHERE else [ring.journal_radius, 0, 0]
+    jbody.add_geom(name=f"{name}__journal", type=_geom_type(jg), size=size, pos=[jp[0], jp[1], 0],
+                   rgba=[0.85, 0.35, 0.2, 1.0], group=0, mass=0, **nocol)
+    sg = options.segment_geom
+    centres = segment_centres(ring)
+    rs = ring.segment_radius
+    for i, (x, y) in enumerate(centres):
+        phi = math.atan2(y, x)
+        gname = f"{name}__seg{i:03d}"
+        if sg is GeomType.BOX:
+            half_t = ring.bearing_radius * math.tan(math.pi / ring.segments) * 1.05
+            hx = 0.25 * ring.bearing_radius
+            cx = bp[0] + (ring.bearing_radius + hx) * math.cos(phi)
+            cy = bp[1] + (ring.bearing_radius + hx) * math.sin(phi)
+            g = bbody.add_geom(name=gname, type=mujoco.mjtGeom.mjGEOM_BOX, size=[hx, half_t, _THICK],
+                               pos=[cx, cy, 0], quat=_quat(phi), **nocol)
+        else:
+            size = [rs, 0, 0] if sg is GeomType.SPHERE else [rs, _THICK, 0]
+            g = bbody.add_geom(name=gname, type=_geom_type(sg), size=size, pos=[bp[0] + x, bp[1] + y, 0], **nocol)
+        g.rgba = [0.3, 0.45, 0.75, 0.35]
+        g.group = 2
+        g.mass = 0
+        pair = spec.add_pair(name=f"{name}__pair{i:03d}", geomname1=f"{name}__journal", geomname2=gname)
+        pair.condim = 3 if friction > 0 else 1
+        pair.friction = [friction, friction, 0.005, 0.0001, 0.0001]
+        d = options.impedance
+        pair.solimp = [d, d, 0.001, 0.5, 2.0]
+        pair.solref = [-1.0, -0.0]
