@@ -1,0 +1,177 @@
+"""The `clearance` command line: the top of the pipeline (may import everything).
+
+    clearance run        simulate a scenario and write arrays, summary, figures, MJCF
+    clearance mjcf       write the MuJoCo model of a scenario
+
+Units on the command line are the ones people use (mm, rpm, µs); they are converted to SI
+here, once.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import sys
+from pathlib import Path
+
+__all__ = ["main", "build_parser"]
+
+
+def _positive(kind: type, name: str):
+    def conv(text: str):
+        try:
+            v = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+        if not (math.isfinite(v) and v > 0):
+            raise argparse.ArgumentTypeError(f"{name} must be > 0 (got {text})")
+        return v
+
+    return conv
+
+
+def _add_scenario_args(p: argparse.ArgumentParser) -> None:
+    g = p.add_argument_group("scenario")
+    g.add_argument("--mechanism", default="slider_crank", choices=["slider_crank"],
+                   help="mechanism from the catalogue (default: slider_crank)")
+    g.add_argument("--clearance-mm", type=_positive(float, "--clearance-mm"), default=0.5,
+                   help="radial clearance c [mm] (default 0.5)")
+    g.add_argument("--clearance-at", nargs="*", default=None, metavar="JOINT",
+                   help="joints with clearance (default: rod_slider for the slider-crank); "
+                        "give none for the ideal mechanism")
+    g.add_argument("--rpm", type=_positive(float, "--rpm"), default=5000.0, help="crank speed [rpm] (default 5000)")
+    g.add_argument("--gravity", action="store_true", help="gravity 9.81 m/s² along -y")
+    g = p.add_argument_group("numerics")
+    g.add_argument("--timestep-us", type=_positive(float, "--timestep-us"), default=1.0,
+                   help="time step [µs] (default 1)")
+    g.add_argument("--segments", type=int, default=None,
+                   help="bearing segment count N (default: chosen by the ripple rule)")
+    g.add_argument("--journal-geom", default="sphere", choices=["sphere", "capsule", "cylinder"])
+    g.add_argument("--segment-geom", default="sphere", choices=["sphere", "capsule", "box", "cylinder"])
+
+
+def _mechanism(args):
+    from clearance.builders import rpm, slider_crank
+
+    at = ("rod_slider",) if args.clearance_at is None else tuple(args.clearance_at)
+    return slider_crank(
+        crank_speed=rpm(args.rpm),
+        radial_clearance=args.clearance_mm * 1e-3,
+        clearance_at=at,
+        gravity=9.81 if args.gravity else 0.0,
+    )
+
+
+def _options(args):
+    from clearance.options import ModelOptions
+
+    return ModelOptions(
+        segments=args.segments,
+        timestep=args.timestep_us * 1e-6,
+        journal_geom=args.journal_geom,
+        segment_geom=args.segment_geom,
+    )
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the `clearance` command."""
+    p = argparse.ArgumentParser(prog="clearance", description=__doc__.split("\n\n")[0])
+    sub = p.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("run", help="simulate a scenario and write results, figures and the model")
+    _add_scenario_args(r)
+    r.add_argument("--revolutions", type=_positive(float, "--revolutions"), default=3.0,
+                   help="crank revolutions to simulate (default 3)")
+    r.add_argument("--duration-ms", type=_positive(float, "--duration-ms"), default=None,
+                   help="simulated time [ms] (overrides --revolutions)")
+    r.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    m = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a scenario")
+    _add_scenario_args(m)
+    m.add_argument("--out", default="model.xml", help="MJCF file to write (default model.xml)")
+    m.add_argument("--ideal", action="store_true", help="write the ideal twin instead")
+    return p
+
+
+def _cmd_mjcf(args) -> int:
+    from clearance.preparation import prepare
+    from clearance.results import atomic_write_text
+
+    mech = _mechanism(args)
+    if args.ideal:
+        mech = mech.ideal_twin()
+    prepared = prepare(mech, _options(args))
+    atomic_write_text(args.out, prepared.to_xml())
+    print(f"wrote {args.out}")
+    return 0
+
+
+def _cmd_run(args) -> int:
+    from clearance.analysis.plots import plot_contact_force, plot_orbit, plot_response
+    from clearance.analysis.summary import summarise, write_summary_csv
+    from clearance.preparation import prepare
+    from clearance.results import atomic_write_text
+    from clearance.simulation import SimulationError, default_duration, simulate_prepared
+
+    mech = _mechanism(args)
+    options = _options(args)
+    duration = args.duration_ms * 1e-3 if args.duration_ms else default_duration(mech, args.revolutions)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    prepared = prepare(mech, options)
+    ideal_prepared = prepare(mech.ideal_twin(), options)
+    atomic_write_text(out / "model.xml", prepared.to_xml())
+    atomic_write_text(out / "ideal_model.xml", ideal_prepared.to_xml())
+    print(f"{mech.name}: clearance at {[j.name for j in mech.clearance_joints]}, "
+          f"{duration * 1e3:.3g} ms at h = {options.timestep:g} s, segments {prepared.metadata['segments']}")
+    progress = not args.no_progress
+    failed = None
+    try:
+        result = simulate_prepared(prepared, duration=duration, progress=progress)
+    except SimulationError as err:
+        failed, result = err, err.partial
+    ideal = simulate_prepared(ideal_prepared, duration=duration, progress=progress)
+    if result is None:
+        print(f"error: {failed}", file=sys.stderr)
+        return 2
+    result.save(out / "result")
+    ideal.save(out / "ideal")
+    rows = summarise(result, ideal)
+    write_summary_csv(rows, out / "summary.csv")
+    output = next(iter(o.name for o in mech.outputs))
+    angular = mech.outputs[0].kind.value == "angle"
+    plot_response(result, ideal, output, angular=angular, path=out / f"{output}_response_vs_ideal.png")
+    if result.joints:
+        plot_contact_force(result, path=out / "contact_force.png")
+    for j in mech.clearance_joints:
+        plot_orbit(result, j.name, j.clearance.radial_clearance, path=out / f"journal_orbit_{j.name}.png")
+    for r in rows:
+        print(f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
+              f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
+              f"max penetration {r.max_penetration * 1e6:.3g} µm")
+    print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * 1e3:.4g} mm" if rows else "")
+    print(f"  {result.metadata['steps_per_second']:.3g} steps/s; wrote {out}/")
+    if failed is not None:
+        print(f"error: {failed}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the `clearance` console script."""
+    from clearance.kinematics import AssemblyError
+
+    args = build_parser().parse_args(argv)
+    try:
+        if args.command == "run":
+            return _cmd_run(args)
+        if args.command == "mjcf":
+            return _cmd_mjcf(args)
+    except (ValueError, AssemblyError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    return 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
