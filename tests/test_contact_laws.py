@@ -170,7 +170,8 @@ def test_bad_arguments_are_named() -> None:
     with pytest.raises(ValueError, match="IMPACT"):
         hysteresis_factor(ContactLaw.IMPACT, 0.9)
     with pytest.raises(ValueError, match="law"):
-        normal_force("lankarani_nikravesh", D, 1.0, 1.0, stiffness=K, restitution=0.9)  # type: ignore[arg-type]
+        bad_law: ContactLaw = "lankarani_nikravesh"  # type: ignore[assignment]
+        normal_force(bad_law, D, 1.0, 1.0, stiffness=K, restitution=0.9)
     with pytest.raises(ValueError, match="friction"):
         ambrosio_friction(1.0, 1.0, friction=-0.1)
     with pytest.raises(ValueError, match="v0"):
