@@ -1,0 +1,44 @@
+"""The command line as a user runs it: outputs written, bad options rejected."""
+
+from __future__ import annotations
+
+import csv
+
+import mujoco
+import pytest
+
+from clearance.cli import main
+
+
+def test_run_writes_everything(tmp_path):
+    out = tmp_path / "out"
+    # a short run (2 ms) of the default scenario keeps the test fast
+    rc = main(["run", "--duration-ms", "2", "--out", str(out), "--no-progress"])
+    assert rc == 0
+    for name in ("result.npz", "result.json", "ideal.npz", "summary.csv", "model.xml", "ideal_model.xml",
+                 "slider_x_response_vs_ideal.png", "contact_force.png", "journal_orbit_rod_slider.png"):
+        assert (out / name).stat().st_size > 0, name
+    rows = list(csv.DictReader((out / "summary.csv").open()))
+    assert rows[0]["joint"] == "rod_slider" and float(rows[0]["peak_force"]) > 0
+    mujoco.MjModel.from_xml_path(str(out / "model.xml"))
+
+
+def test_mjcf_command(tmp_path):
+    path = tmp_path / "m.xml"
+    assert main(["mjcf", "--out", str(path), "--segments", "36"]) == 0
+    model = mujoco.MjModel.from_xml_path(str(path))
+    assert model.npair == 36
+
+
+@pytest.mark.parametrize("argv", [["run", "--clearance-mm", "-1"], ["run", "--rpm", "0"], ["run", "--bogus"]])
+def test_bad_options_exit_with_usage_error(argv, capsys):
+    with pytest.raises(SystemExit) as info:
+        main(argv)
+    assert info.value.code == 2
+    assert "error" in capsys.readouterr().err
+
+
+def test_bad_values_reported_clearly(tmp_path, capsys):
+    rc = main(["run", "--clearance-mm", "20", "--out", str(tmp_path), "--no-progress"])
+    assert rc == 2
+    assert "radial_clearance" in capsys.readouterr().err

@@ -1,0 +1,44 @@
+"""SimulationResult persistence: lossless round trip, atomic files."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from clearance.results import JointResult, SimulationResult
+
+
+def _result(n=50):
+    rng = np.random.default_rng(0)
+    return SimulationResult(
+        times=np.arange(n) * 1e-6,
+        outputs={"slider_x": rng.normal(size=n), "slider_x_vel": rng.normal(size=n), "slider_x_acc": rng.normal(size=n)},
+        joints={"rod_slider": JointResult(rng.normal(size=(n, 2)), rng.normal(size=(n, 2)), rng.normal(size=n), rng.normal(size=(n, 2)))},
+        drive_angle=rng.normal(size=(n, 1)),
+        drive_speed=rng.normal(size=(n, 1)),
+        drive_torque=rng.normal(size=(n, 1)),
+        link_poses=rng.normal(size=(n, 3, 3)),
+        closure_violation=np.zeros(n),
+        metadata={"solver": "mujoco", "segments": {"rod_slider": 144}, "time_step": 1e-6},
+    )
+
+
+def test_round_trip_is_lossless(tmp_path):
+    r = _result()
+    npz, js = r.save(tmp_path / "run")
+    assert npz.exists() and js.exists()
+    back = SimulationResult.load(tmp_path / "run.npz")
+    assert np.array_equal(back.times, r.times)
+    for k in r.outputs:
+        assert np.array_equal(back.outputs[k], r.outputs[k])
+    for f in ("eccentricity", "eccentricity_rate", "penetration", "contact_force"):
+        assert np.array_equal(getattr(back.joints["rod_slider"], f), getattr(r.joints["rod_slider"], f))
+    assert np.array_equal(back.link_poses, r.link_poses)
+    assert back.metadata == r.metadata
+    assert not list(tmp_path.glob(".*tmp"))  # no temporary files left behind
+
+
+def test_slicing_and_concatenation():
+    r = _result(10)
+    joined = SimulationResult.concatenate([r.sliced(slice(0, 4)), r.sliced(slice(4, 10))])
+    assert np.array_equal(joined.times, r.times)
+    assert len(r.decimated(3)) == 4

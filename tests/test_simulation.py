@@ -1,0 +1,126 @@
+"""MuJoCo runs of the default slider-crank: ideal twin vs analytic, clearance runs, halving."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from clearance import ModelOptions, simulate
+from clearance.builders import rpm, slider_crank
+from clearance.simulation import SimulationError
+
+
+@pytest.fixture(scope="module")
+def ideal_run():
+    mech = slider_crank().ideal_twin()
+    period = 2 * math.pi / rpm(5000)
+    return simulate(mech, duration=period, options=ModelOptions(timestep=1e-6))
+
+
+def test_ideal_twin_matches_analytic_kinematics(ideal_run):
+    r = ideal_run
+    acc = r.outputs["slider_x_acc"]
+    vel = r.outputs["slider_x_vel"]
+    # REFERENCES.md section 3 (derived): -19,419 / +9,696 m/s^2, 28.41 m/s; the issue asks 0.5 %
+    assert acc.min() == pytest.approx(-19419, rel=5e-3)
+    assert acc.max() == pytest.approx(9696, rel=5e-3)
+    assert np.abs(vel).max() == pytest.approx(28.41, rel=5e-3)
+    # position against the closed form x = r cos(th) + sqrt(l^2 - r^2 sin^2(th))
+    th = r.drive_angle[:, 0]
+    x = 0.05 * np.cos(th) + np.sqrt(0.12**2 - (0.05 * np.sin(th)) ** 2)
+    # 1 um: the soft loop closure and drive servo errors measured are below 0.1 um
+    assert np.max(np.abs(r.outputs["slider_x"] - x)) < 1e-6
+
+
+def test_drive_speed_within_0p1_percent(ideal_run):
+    w = rpm(5000)
+    # the issue's bound: 0.1 % of 5000 rpm
+    assert np.max(np.abs(ideal_run.drive_speed[:, 0] - w)) < 1e-3 * w
+
+
+def test_ideal_run_has_no_contact_or_closure_error(ideal_run):
+    assert ideal_run.joints == {}
+    # the ideal twin closes its loop with a connect equality (time constant 2 h); MUJOCO_NOTES.md
+    # measured 0.34 um with a 1e-5 s time constant at 5000 rpm: 1 um bounds it
+    assert 0 < np.max(ideal_run.closure_violation) < 1e-6
+
+
+@pytest.fixture(scope="module")
+def clearance_run(default_prepared):
+    from clearance.simulation import simulate_prepared
+
+    # one revolution at 5000 rpm = 12 ms
+    return simulate_prepared(default_prepared, duration=0.012)
+
+
+def test_journal_stays_inside_clearance_plus_bound(clearance_run, default_prepared):
+    jr = clearance_run.joints["rod_slider"]
+    bound = default_prepared.sizing["rod_slider"].penetration_limit
+    # the bound is 4x the Hertz penetration of an impact at the speed gained crossing the
+    # clearance under the ideal peak joint load (preparation.JointSizing); c = 0.5 mm
+    assert np.max(np.hypot(*jr.eccentricity.T)) < 0.5e-3 + bound
+    assert bound < 0.5e-3  # and the bound itself is a fraction of the clearance here
+
+
+def test_contacts_occur(clearance_run):
+    jr = clearance_run.joints["rod_slider"]
+    assert np.any(jr.penetration > 0)
+    assert np.max(jr.force_magnitude) > 1e3  # REFERENCES.md section 3: forces of order 1e4 N
+    # first impact about 0.25 ms after start (REFERENCES.md section 6); 0.05 ms tolerance
+    # because the nominal contact stiffness and effective mass shift it slightly
+    t_first = clearance_run.times[np.argmax(jr.penetration > 0)]
+    assert abs(t_first - 0.25e-3) < 0.05e-3
+
+
+def test_contact_force_follows_the_stiffness(clearance_run, default_prepared):
+    jr = clearance_run.joints["rod_slider"]
+    K = default_prepared.sizing["rod_slider"].stiffness
+    on = jr.penetration > 5e-6
+    e = jr.eccentricity[on]
+    fn = -(jr.contact_force[on] * e).sum(1) / np.hypot(*e.T)
+    ratio = fn / (K * jr.penetration[on] ** 1.5)
+    # the ring is sized to K within its fit (about 3 %) and damping adds or subtracts during
+    # an impact; the median over the run stays within 10 % of the Hertz-type law
+    assert abs(np.median(ratio) - 1) < 0.10
+
+
+def test_time_step_halving_first_impact_peak(default_prepared):
+    mech = default_prepared.mechanism
+    params = default_prepared.contact  # fixed, uncalibrated parameters (CLARIFICATIONS)
+    peaks = []
+    for h in (1e-6, 0.5e-6):
+        r = simulate(mech, duration=0.5e-3, options=ModelOptions(timestep=h, segments=144), contact=params)
+        peaks.append(r.joints["rod_slider"].force_magnitude.max())
+    # the first impact lasts ~30 us; sampling its peak at 1 us costs up to ~0.5 % and the
+    # integrator error at omega*h ~ 0.1 is smaller (measured 0.07 %)
+    assert peaks[1] == pytest.approx(peaks[0], rel=5e-3)
+
+
+def test_time_step_too_large_is_explained():
+    from clearance.preparation import TimeStepError
+
+    with pytest.raises(TimeStepError, match=r"largest stable"):
+        simulate(slider_crank(), duration=1e-3, options=ModelOptions(timestep=1e-4))
+
+
+def test_divergence_names_time_joint_and_keeps_partial():
+    # contact 1000x softer than the bearing: the journal sinks beyond the bound at once
+    from clearance.options import ContactParameters
+
+    soft = {"rod_slider": ContactParameters(stiffness=1e3, damping=0.0)}
+    with pytest.raises(SimulationError) as info:
+        simulate(slider_crank(), duration=3e-3, contact=soft, options=ModelOptions(segments=36))
+    err = info.value
+    assert err.joint == "rod_slider" and err.time is not None
+    assert "Remedy" in str(err)
+    assert err.partial is not None and len(err.partial.times) > 0
+    assert err.partial.times[-1] < err.time + 1e-12
+
+
+def test_bad_arguments_fail_before_work():
+    with pytest.raises(ValueError, match="duration must be a positive"):
+        simulate(slider_crank(), duration=-1.0)
+    with pytest.raises(TypeError):
+        simulate(slider_crank(), duraton=1.0)
