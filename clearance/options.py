@@ -11,7 +11,7 @@ import enum
 import math
 from dataclasses import dataclass
 
-__all__ = ["GeomType", "ContactMode", "ModelOptions", "ContactParameters", "DEFAULT_SEGMENTS"]
+__all__ = ["GeomType", "ContactMode", "ModelOptions", "ContactParameters"]
 
 
 class GeomType(enum.Enum):
@@ -38,17 +38,14 @@ class ContactMode(enum.Enum):
     EXACT_LN = "exact_ln"
 
 
-DEFAULT_SEGMENTS = 160
-"""Default bearing segment count (see benchmarks/segments_speed.md for how it was chosen)."""
-
-
 @dataclass(frozen=True)
 class ModelOptions:
     """Numerical choices of a MuJoCo model and run.
 
     Attributes:
-        segments: bearing segment count N (>= 8), or None to choose N per joint by the
-            ripple rule (`clearance.mjcf.bearing.choose_segments`).
+        segments: bearing segment count N (>= 8), or None (default) to choose N per joint
+            by the ripple rule (`clearance.mjcf.bearing.choose_segments`; N = 144 for the
+            default scenario, see benchmarks/segments_speed.md).
         journal_geom: journal geom type (SPHERE or CAPSULE; CYLINDER uses the convex
             collider).
         segment_geom: bearing segment geom type (SPHERE, CAPSULE, BOX or CYLINDER).
