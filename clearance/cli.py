@@ -86,6 +86,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="simulated time [ms] (overrides --revolutions)")
     r.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.add_argument("--rerun", default=None, metavar="PATH",
+                   help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH")
     m = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a scenario")
     _add_scenario_args(m)
     m.add_argument("--out", default="model.xml", help="MJCF file to write (default model.xml)")
@@ -136,6 +138,10 @@ def _cmd_run(args) -> int:
         return 2
     result.save(out / "result")
     ideal.save(out / "ideal")
+    if args.rerun:
+        from clearance.analysis.rerun_log import record
+
+        print(f"  wrote {record(result, mech, args.rerun, ideal=ideal)}")
     rows = summarise(result, ideal)
     write_summary_csv(rows, out / "summary.csv")
     output = next(iter(o.name for o in mech.outputs))
