@@ -314,8 +314,11 @@ def _log_mechanism(recording: rr.RecordingStream, run: LoggedRun, max_rate_hz: f
         strips.append(p)
         colors.append(_LINK_COLORS[i % len(_LINK_COLORS)])
         labels.append(name)
-    n = len(rows)
-    flat = [strips[k][r] for r in range(n) for k in range(len(strips))]
+    n, kmax = len(rows), max(p.shape[1] for p in strips)
+    # pad every strip to kmax points by repeating its last point (draws the same), so the
+    # strips are one (n * n_links, kmax, 2) array: rerun's numpy fast path, no Python per row
+    flat = np.stack([np.concatenate([p, np.repeat(p[:, -1:], kmax - p.shape[1], axis=1)], axis=1) for p in strips],
+                    axis=1).reshape(-1, kmax, 2)
     links_path, joints_path, ground_path = (run.path(f"mechanism/{e}") for e in ("links", "joints", "ground"))
     recording.send_columns(links_path, indexes=idx,
                            columns=rr.LineStrips2D.columns(strips=flat).partition([len(strips)] * n))
