@@ -494,7 +494,9 @@ def stream(
         url: gRPC address of a running viewer when ``recording`` is None (rerun's
             default address when None).
         spawn: when ``recording`` is None, start a viewer instead of connecting to one.
-        blueprint: send the default layout too.
+        blueprint: send the default layout of this run too. For several runs in one live
+            recording, log each with ``blueprint=False`` and send
+            ``make_blueprint(runs)`` once with ``recording.send_blueprint``.
 
     Returns:
         The recording stream (still open; later runs may be logged into it under other
@@ -506,7 +508,7 @@ def stream(
         if spawn:
             recording.spawn()
         else:
-            recording.connect_grpc(url) if url else recording.connect_grpc()
+            recording.connect_grpc(url)
     if blueprint:
         recording.send_blueprint(make_blueprint([run]))
     log_run(recording, run, max_rate_hz=max_rate_hz)
