@@ -1,0 +1,96 @@
+"""Build a `SimulationResult` from a reference `Trajectory` (same conventions as MuJoCo runs).
+
+At each output sample the equations of motion are solved once more (in the contact mode of
+that sample) for accelerations, contact forces and drive torques. Frames and signs:
+
+  * eccentricity: journal centre minus bearing centre in the bearing link's frame;
+    eccentricity_rate: the time derivative of that frame-expressed vector;
+  * contact_force: force on the journal (normal + friction) in the bearing frame;
+  * drive_angle, drive_speed: theta_b - theta_a of the driven joint and its rate;
+    drive_torque: torque the drive applies to link_b (positive work at positive speed);
+  * closure_violation: largest ideal-joint closure error [m] (revolute: norm of the
+    position mismatch; prismatic: distance from the guide line);
+  * link_poses: link-frame poses (x, y, theta) of the moving links.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from clearance.kinematics import output_kinematics
+from clearance.reference.integrator import Trajectory
+from clearance.reference.system import ReferenceSystem
+from clearance.results import JointResult, SimulationResult
+
+__all__ = ["assemble_result"]
+
+
+def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[str, Any]) -> SimulationResult:
+    """Evaluate every sample of ``traj`` and pack the `SimulationResult`.
+
+    Args:
+        system: the system that produced the trajectory.
+        traj: the raw solution.
+        metadata: the result's metadata (completed here with energy data if tracked).
+    """
+    n, nq, nc, nd = len(traj.times), system.nq, len(system.contacts), len(system.drives)
+    zdd = np.empty((n, nq))
+    cres = np.zeros((n, nc, 13))
+    torque = np.empty((n, nd))
+    closure = np.empty(n)
+    for i in range(n):
+        ev = system.evaluate(float(traj.times[i]), traj.z[i].tolist(), traj.zd[i].tolist(),
+                             traj.vin[i].tolist())
+        zdd[i] = ev.zdd
+        if nc:
+            cres[i] = ev.contacts
+        torque[i] = ev.drive_torque
+        closure[i] = system.rows.closure(ev.phi) if ev.phi else 0.0
+    q, qd, qdd = system.from_com(traj.z, traj.zd, zdd)
+    mech = system.mechanism
+    outputs = output_kinematics(mech, q, qd, qdd) if mech is not None else {}
+
+    joints: dict[str, JointResult] = {}
+    for k, cj in enumerate(system.contacts):
+        ex, ey, edx, edy = (cres[:, k, i] for i in range(4))
+        fx, fy = cres[:, k, 7], cres[:, k, 8]
+        if cj.ib >= 0:
+            th, w = q[:, 3 * cj.ib + 2], qd[:, 3 * cj.ib + 2]
+        else:
+            th, w = np.zeros(n), np.zeros(n)
+        c, s = np.cos(th), np.sin(th)
+        e = np.stack([c * ex + s * ey, -s * ex + c * ey], axis=1)
+        # d/dt (R^T e_w) = R^T e_w' + w (e_y, -e_x) in the bearing frame
+        erate = np.stack([c * edx + s * edy + w * e[:, 1], -s * edx + c * edy - w * e[:, 0]], axis=1)
+        force = np.stack([c * fx + s * fy, -s * fx + c * fy], axis=1)
+        pen = np.hypot(e[:, 0], e[:, 1]) - cj.c
+        joints[cj.name] = JointResult(e, erate, pen, force)
+
+    angle, speed = np.empty((n, nd)), np.empty((n, nd))
+    for k, d in enumerate(system.drives):
+        tb = q[:, 3 * d.ib + 2] if d.ib >= 0 else 0.0
+        ta = q[:, 3 * d.ia + 2] if d.ia >= 0 else 0.0
+        wb = qd[:, 3 * d.ib + 2] if d.ib >= 0 else 0.0
+        wa = qd[:, 3 * d.ia + 2] if d.ia >= 0 else 0.0
+        angle[:, k] = tb - ta
+        speed[:, k] = wb - wa
+    meta = dict(metadata)
+    if traj.work is not None:
+        kin, pot, grav = system.energy(traj.z, traj.zd)
+        meta["drive_work"] = traj.work.tolist()
+        meta["energy"] = {"kinetic": kin.tolist(), "contact_potential": pot.tolist(),
+                          "gravity_potential": grav.tolist()}
+    meta["max_closure_violation"] = float(closure.max()) if n else 0.0
+    return SimulationResult(
+        times=np.array(traj.times, dtype=float),
+        outputs=outputs,
+        joints=joints,
+        drive_angle=angle,
+        drive_speed=speed,
+        drive_torque=torque,
+        link_poses=q.reshape(n, len(system.links), 3),
+        closure_violation=closure,
+        metadata=meta,
+    )
