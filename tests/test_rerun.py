@@ -237,3 +237,32 @@ def test_cli_run_writes_a_recording(tmp_path):
     data, blueprints = _read(rrd)
     assert ("/joints/rod_slider/orbit", False) in data and ("/outputs/slider_x/displacement/ideal", False) in data
     assert blueprints
+
+
+def test_reference_solver_run_records_like_a_mujoco_run(runs, tmp_path):
+    from clearance.reference import run_reference
+
+    mech, res = runs["one"]
+    ref = run_reference(mech, 2e-4)
+    assert ref.metadata["solver"] == "reference"
+    path = rerun_log.record_runs(
+        [rerun_log.LoggedRun(res, mech, prefix="mujoco"), rerun_log.LoggedRun(ref, mech, prefix="reference")],
+        tmp_path / "cmp.rrd",
+    )
+    data, _ = _read(path)
+    pos = np.asarray([row[0] for row in data[("/reference/joints/rod_slider/orbit", False)]["Points2D:positions"]], float)
+    np.testing.assert_allclose(pos, ref.joints["rod_slider"].eccentricity * 1e6, rtol=F32_RTOL, atol=0)
+    force = _squeeze(data[("/reference/joints/rod_slider/force/magnitude", False)]["Scalars:scalars"])
+    assert np.array_equal(force, ref.joints["rod_slider"].force_magnitude)
+    # Before the first impact (~0.25 ms) both solvers move the ideal mechanism alike (they
+    # differ by < 1e-9 m): joints drawn at the same display times agree to float32 of mm
+    # values at up to 170 mm (half an ulp ~ 8e-6 mm on each side) -> 2e-5 mm.
+    mj, rf = data[("/mujoco/mechanism/joints", False)], data[("/reference/mechanism/joints", False)]
+    t_mj, t_rf = mj[rerun_log.TIME_TIMELINE], rf[rerun_log.TIME_TIMELINE]
+    common = np.intersect1d(t_mj, t_rf)
+    assert len(common) >= 4  # 0, 50, 100, 150 µs at the default display rate
+
+    def pick(d: dict, t: np.ndarray) -> np.ndarray:
+        return np.asarray([np.asarray(d["Points2D:positions"][i], float) for i in np.searchsorted(t, common)])
+
+    np.testing.assert_allclose(pick(rf, t_rf), pick(mj, t_mj), atol=2e-5)
