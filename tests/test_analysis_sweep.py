@@ -1,0 +1,93 @@
+"""Sweeps: resume after an injected stop, process pool against Dask, row contents."""
+
+from __future__ import annotations
+
+import functools
+import json
+
+import pytest
+
+from clearance.analysis.sweep import KeywordFactory, SweepEvaluation, load_rows, run_sweep
+from clearance.builders import rpm, slider_crank
+from clearance.options import ModelOptions
+from clearance.simulation import default_duration
+
+# low speed and a coarse step keep each point under a second (1000 rpm: T = 60 ms)
+OPTIONS = ModelOptions(timestep=5e-6, segments=36)
+MAKE = KeywordFactory(slider_crank, fixed={"crank_speed": rpm(1000.0)})
+POINTS = [{"radial_clearance": c} for c in (0.1e-3, 0.2e-3, 0.35e-3, 0.5e-3)]
+DURATION = functools.partial(default_duration, revolutions=2.0)
+
+
+def _sweep(out, **kw):
+    return run_sweep(POINTS, MAKE, out_dir=out, duration=DURATION, options=OPTIONS, progress=False,
+                     max_workers=2, **kw)
+
+
+@pytest.fixture(scope="module")
+def full(tmp_path_factory):
+    out = tmp_path_factory.mktemp("full")
+    return _sweep(out)
+
+
+def test_rows_hold_statistics_summary_and_poincare(full):
+    assert full.complete and full.new == 4
+    assert [r["index"] for r in full.rows] == [0, 1, 2, 3]
+    r = full.rows[-1]
+    assert r["status"] == "ok", r["error"]
+    assert r["point"] == POINTS[-1]
+    assert set(r["summary"]) == {"rod_slider"}
+    # the slider cannot leave the ideal path by more than c plus the penetration (< 0.05 mm)
+    assert 0 < r["statistics"]["mean_deviation"] < 0.55e-3
+    assert len(r["per_cycle_mean_deviation"]) == 1  # 2 periods minus the skipped one
+    assert r["poincare"]["quantities"] == ["slider_x", "slider_x_vel"]
+    assert len(r["poincare"]["points"]) == 1  # section at t = T (t = 2T is past the end)
+    header = full.csv_path.read_text().splitlines()[0].split(",")
+    assert header[:3] == ["index", "point.radial_clearance", "status"]
+    assert "statistics.mean_deviation" in header and "summary.rod_slider.peak_force" in header
+
+
+def test_resumed_sweep_equals_uninterrupted(full, tmp_path):
+    part = _sweep(tmp_path, stop_after=2)
+    assert not part.complete and part.new == 2
+    assert len(list((tmp_path / "points").glob("*.json"))) == 2
+    rest = _sweep(tmp_path)
+    assert rest.complete and rest.new == 2
+    # same thread count (one MuJoCo thread per run): bitwise-equal table
+    assert rest.csv_path.read_bytes() == full.csv_path.read_bytes()
+    # a finished sweep run again computes nothing
+    assert _sweep(tmp_path).new == 0
+
+
+def test_dask_executor_matches_process_pool(full, tmp_path):
+    distributed = pytest.importorskip("dask.distributed")
+    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        out = run_sweep(POINTS, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS,
+                        progress=False, scheduler_address=cluster.scheduler_address)
+    assert out.complete
+    assert out.csv_path.read_bytes() == full.csv_path.read_bytes()
+
+
+def test_errors_are_rows_and_other_sweeps_are_refused(tmp_path):
+    bad = [{"radial_clearance": 0.5e-3, "rod_length": 0.01}]  # rod shorter than crank
+    out = run_sweep(bad, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False,
+                    executor=_Inline(), evaluation=SweepEvaluation(ideal=False))
+    row = load_rows(tmp_path)[0]
+    assert out.complete and row["status"] == "error" and "rod_length" in row["error"]
+    assert json.loads((tmp_path / "points" / "point_000000.json").read_text())["index"] == 0
+    with pytest.raises(ValueError, match="different sweep"):
+        run_sweep(POINTS, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False,
+                  executor=_Inline())
+    with pytest.raises(ValueError, match="stop_after"):
+        run_sweep(POINTS, MAKE, out_dir=tmp_path / "x", stop_after=0, executor=_Inline())
+
+
+class _Inline:
+    """Minimal executor running each call at submit (for tests without processes)."""
+
+    def submit(self, fn, *args):
+        from concurrent.futures import Future
+
+        f = Future()
+        f.set_result(fn(*args))
+        return f
