@@ -291,8 +291,11 @@ def to_result(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any
 def _metadata(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any]) -> dict[str, Any]:
     mech = system.mechanism
     onsets: dict[str, list] = {n: [] for n in system.contact_names}
+    ends: dict[str, list] = {n: [] for n in system.contact_names}
     for t, k, v in traj.onsets:
         onsets[system.contact_names[k]].append([t, v])
+    for t, k in traj.ends:
+        ends[system.contact_names[k]].append(t)
     return {
         "solver": "reference",
         **settings,
@@ -314,6 +317,7 @@ def _metadata(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any
         "min_approach_speed": system.min_approach_speed,
         "impacts": {n: len(v) for n, v in onsets.items()},
         "contact_onsets": onsets,
+        "contact_ends": ends,
         "n_rhs": traj.n_rhs,
         "n_steps": traj.n_steps,
         "n_restarts": traj.n_restarts,

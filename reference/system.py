@@ -18,6 +18,7 @@ system (G M^-1 G^T) lambda = G M^-1 Q - gamma_s: one dense solve per call.
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Sequence
 from typing import Any, NamedTuple
@@ -26,7 +27,7 @@ import numpy as np
 from scipy.linalg.lapack import dposv
 
 from clearance.kinematics import assemble, velocities
-from clearance.model import DriveKind, Joint, Link, Mechanism
+from clearance.model import DriveKind, Joint, Link, Mechanism, MotionLaw
 from clearance.reference.constraints import ConstraintRows
 from clearance.reference.contact import ContactJoint, contact_joints, evaluate_contact
 
@@ -233,6 +234,9 @@ class ReferenceSystem:
     def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
         """The ideal mechanism assembled at t = 0 with ideal velocities, journals centred.
 
+        A torque-driven joint starts at its drive's start angle, at rest relative to its
+        other link.
+
         Returns:
             (q, qd): link-frame coordinates (nq,) [m, rad] and velocities [m/s, rad/s].
 
@@ -242,8 +246,15 @@ class ReferenceSystem:
         """
         if self.mechanism is None:
             raise ValueError("a system built from parts has no assembly: give q0 and qd0")
-        q = assemble(self.mechanism, 0.0)
-        return q, velocities(self.mechanism, q, 0.0)
+        mech = self.mechanism
+        if any(d.kind is DriveKind.TORQUE for d in mech.drives):
+            # hold torque-driven joints at their start angle, at rest, for the assembly
+            held = MotionLaw(0.0, period=1.0)
+            mech = dataclasses.replace(mech, drives=tuple(
+                dataclasses.replace(d, kind=DriveKind.MOTION_LAW, motion=held)
+                if d.kind is DriveKind.TORQUE else d for d in mech.drives))
+        q = assemble(mech, 0.0)
+        return q, velocities(mech, q, 0.0)
 
     # -- dynamics ----------------------------------------------------------------------------
     def evaluate(
