@@ -40,7 +40,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
-from clearance.model import JointType, Mechanism
+from clearance.model import Mechanism
 from clearance.results import SimulationResult
 
 __all__ = [
@@ -158,45 +158,25 @@ def _display_rows(times: np.ndarray, max_rate_hz: float | None) -> np.ndarray:
     return np.union1d(rows, [n - 1])
 
 
-def _world_points(run: LoggedRun, rows: np.ndarray) -> tuple[dict[str, np.ndarray], bool]:
+def _world_points(run: LoggedRun, rows: np.ndarray) -> dict[str, np.ndarray]:
     """World positions [m] of every link's points at ``rows``: name -> (r, k, 2).
 
-    The pose of a link is read as its frame origin; if the first row closes the ideal
-    revolute joints better when it is read as the centre of mass, that reading is used
-    (MuJoCo body sensors report the inertial frame). Returns the points and whether the
-    centre-of-mass reading was chosen.
+    ``link_poses`` hold each link frame's origin and angle (both solvers).
     """
     mech, poses = run.mechanism, run.result.link_poses
     moving = [lk.name for lk in mech.moving_links]
-
-    def points(sel: np.ndarray, com: bool) -> dict[str, np.ndarray]:
-        out = {}
-        for lk in mech.links:
-            p = np.array(list(lk.points.values()), float).reshape(-1, 2)
-            if lk.name not in moving:
-                out[lk.name] = np.broadcast_to(p, (len(sel), *p.shape))
-                continue
-            if com:
-                p = p - np.asarray(lk.com)
-            pose = poses[sel, moving.index(lk.name)]
-            c, s = np.cos(pose[:, 2])[:, None], np.sin(pose[:, 2])[:, None]
-            out[lk.name] = np.stack(
-                [pose[:, :1] + c * p[:, 0] - s * p[:, 1], pose[:, 1:2] + s * p[:, 0] + c * p[:, 1]], axis=-1
-            )
-        return out
-
-    def residual(pts: dict[str, np.ndarray]) -> float:
-        err = 0.0
-        for j in mech.joints:
-            if j.kind is JointType.REVOLUTE and j.clearance is None:
-                a = pts[j.link_a][0, list(mech.link(j.link_a).points).index(j.point_a)]
-                b = pts[j.link_b][0, list(mech.link(j.link_b).points).index(j.point_b)]
-                err += float(np.hypot(*(a - b)))
-        return err
-
-    first = np.array([0])
-    use_com = residual(points(first, True)) < residual(points(first, False))
-    return points(rows, use_com), use_com
+    out = {}
+    for lk in mech.links:
+        p = np.array(list(lk.points.values()), float).reshape(-1, 2)
+        if lk.name not in moving:
+            out[lk.name] = np.broadcast_to(p, (len(rows), *p.shape))
+            continue
+        pose = poses[rows, moving.index(lk.name)]
+        c, s = np.cos(pose[:, 2])[:, None], np.sin(pose[:, 2])[:, None]
+        out[lk.name] = np.stack(
+            [pose[:, :1] + c * p[:, 0] - s * p[:, 1], pose[:, 1:2] + s * p[:, 0] + c * p[:, 1]], axis=-1
+        )
+    return out
 
 
 def _drive_names(run: LoggedRun) -> list[str]:
@@ -299,7 +279,7 @@ def log_run(recording: rr.RecordingStream, run: LoggedRun, *, max_rate_hz: float
 def _log_mechanism(recording: rr.RecordingStream, run: LoggedRun, max_rate_hz: float | None) -> list[str]:
     res, mech = run.result, run.mechanism
     rows = _display_rows(res.times, max_rate_hz)
-    pts, _ = _world_points(run, rows)
+    pts = _world_points(run, rows)
     idx = _indexes(res.times, res.drive_angle, rows)
     size = max((float(np.abs(p).max()) for p in pts.values() if p.size), default=0.1) or 0.1
     moving = [lk.name for lk in mech.moving_links]

@@ -7,7 +7,7 @@ mass). Collisions happen only through explicit `<pair>` elements between each jo
 its own bearing segments; every geom has contype = conaffinity = 0.
 
 Sensor names (read by `clearance.simulate`):
-  ``<link>__pos``, ``<link>__xaxis``: body frame position and x axis (world);
+  ``<link>__pos``, ``<link>__xaxis``: link (body) frame origin and x axis (world);
   ``<joint>__ecc``: journal centre in the bearing frame;
   ``<joint>__jvel``, ``<joint>__bvel``, ``<joint>__bangvel``, ``<joint>__bxaxis``: world
   velocities of journal and bearing centres, bearing angular velocity and x axis;
@@ -218,8 +218,9 @@ def build_spec(
         s.intprm[:3] = [2, 3, 1]  # data = force, reduce = netforce, num = 1
 
     for n in names:
-        _sensor(spec, f"{n}__pos", _SENS.mjSENS_FRAMEPOS, _OBJ.mjOBJ_BODY, n)
-        _sensor(spec, f"{n}__xaxis", _SENS.mjSENS_FRAMEXAXIS, _OBJ.mjOBJ_BODY, n)
+        # xbody: the body (link) frame; "body" would be the inertial frame at the centre of mass
+        _sensor(spec, f"{n}__pos", _SENS.mjSENS_FRAMEPOS, _OBJ.mjOBJ_XBODY, n)
+        _sensor(spec, f"{n}__xaxis", _SENS.mjSENS_FRAMEXAXIS, _OBJ.mjOBJ_XBODY, n)
 
     for o in mechanism.outputs:
         if o.kind is OutputKind.ANGLE:

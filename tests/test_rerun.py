@@ -157,12 +157,7 @@ def test_two_clearance_joints(runs, tmp_path):
 def _reference_like(res: SimulationResult, mech) -> SimulationResult:
     """A reference-solver-shaped result: every 10th row, link-frame poses, solver "reference"."""
     r = res.decimated(10)
-    poses = r.link_poses.copy()
-    for i, lk in enumerate(mech.moving_links):
-        th = poses[:, i, 2]
-        cx, cy = lk.com
-        poses[:, i, 0] -= np.cos(th) * cx - np.sin(th) * cy
-        poses[:, i, 1] -= np.sin(th) * cx + np.cos(th) * cy
+    poses = r.link_poses.copy()  # link-frame poses, as both solvers store them
     joints = {k: JointResult(v.eccentricity, v.eccentricity_rate, v.penetration, v.contact_force) for k, v in r.joints.items()}
     meta = {"solver": "reference", "mechanism": mech.name, "clearance_joints": list(joints),
             "links": [lk.name for lk in mech.moving_links]}
@@ -183,8 +178,7 @@ def test_mujoco_and_reference_in_one_recording(runs, tmp_path):
         np.testing.assert_allclose(pos, r.joints["rod_slider"].eccentricity * 1e6, rtol=F32_RTOL, atol=0)
         force = _squeeze(data[(f"/{prefix}/joints/rod_slider/force/magnitude", False)]["Scalars:scalars"])
         assert np.array_equal(force, r.joints["rod_slider"].force_magnitude)
-    # Both pose conventions (MuJoCo's centre of mass, the reference's link frame) draw the
-    # same joints: float32 of mm values (~1e-5 mm at 170 mm) plus the pose round-off.
+    # Both results draw the same joints: float32 of mm values (~1e-5 mm at 170 mm).
     jm = np.asarray([np.asarray(x, float) for x in data[("/mujoco/mechanism/joints", False)]["Points2D:positions"]])
     jf = np.asarray([np.asarray(x, float) for x in data[("/reference/mechanism/joints", False)]["Points2D:positions"]])
     np.testing.assert_allclose(jf, jm[::10], atol=1e-4)

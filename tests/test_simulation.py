@@ -124,3 +124,13 @@ def test_bad_arguments_fail_before_work():
         simulate(slider_crank(), duration=-1.0)
     with pytest.raises(TypeError):
         simulate(slider_crank(), duraton=1.0)
+
+
+def test_link_poses_are_link_frames(ideal_run):
+    """link_poses hold each link frame's origin (not its centre of mass): compare with kinematics."""
+    from clearance.kinematics import assemble
+
+    mech = slider_crank().ideal_twin()
+    q0 = assemble(mech, 0.0).reshape(-1, 3)
+    # the first row is the keyframe pose, written from the same assembly: round-off only
+    assert np.allclose(ideal_run.link_poses[0], q0, atol=1e-12)
