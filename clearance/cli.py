@@ -1,6 +1,7 @@
 """The `clearance` command line: the top of the pipeline (may import everything).
 
     clearance run        simulate a scenario and write arrays, summary, figures, MJCF
+    clearance reference  run a scenario with the exact-geometry reference solver
     clearance mjcf       write the MuJoCo model of a scenario
 
 Units on the command line are the ones people use (mm, rpm, µs); they are converted to SI
@@ -88,6 +89,18 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.add_argument("--rerun", default=None, metavar="PATH",
                    help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH")
+    f = sub.add_parser("reference", help="run a scenario with the exact-geometry reference solver (slow)")
+    _add_scenario_args(f)
+    f.add_argument("--revolutions", type=_positive(float, "--revolutions"), default=1.0,
+                   help="crank revolutions to simulate (default 1)")
+    f.add_argument("--duration-ms", type=_positive(float, "--duration-ms"), default=None,
+                   help="simulated time [ms] (overrides --revolutions)")
+    f.add_argument("--rtol", type=_positive(float, "--rtol"), default=1e-9, help="relative tolerance (default 1e-9)")
+    f.add_argument("--output-us", type=_positive(float, "--output-us"), default=10.0,
+                   help="output interval [µs] (default 10)")
+    f.add_argument("--out", default="clearance-reference-out", help="output folder (default clearance-reference-out)")
+    f.add_argument("--rerun", default=None, metavar="PATH", help="also write a rerun recording (.rrd) to PATH")
+    f.add_argument("--no-progress", action="store_true", help="no progress bar")
     m = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a scenario")
     _add_scenario_args(m)
     m.add_argument("--out", default="model.xml", help="MJCF file to write (default model.xml)")
@@ -108,16 +121,49 @@ def _cmd_mjcf(args) -> int:
     return 0
 
 
-def _cmd_run(args) -> int:
+def _write_outputs(args, mech, result, ideal, out: Path) -> None:
+    """Arrays, summary CSV, figures (and a rerun recording) of a run and its ideal twin."""
     from clearance.analysis.plots import plot_contact_force, plot_orbit, plot_response
     from clearance.analysis.summary import summarise, write_summary_csv
+
+    result.save(out / "result")
+    ideal.save(out / "ideal")
+    if getattr(args, "rerun", None):
+        from clearance.analysis.rerun_log import record
+
+        print(f"  wrote {record(result, mech, args.rerun, ideal=ideal)}")
+    rows = summarise(result, ideal)
+    write_summary_csv(rows, out / "summary.csv")
+    output = mech.outputs[0].name
+    angular = mech.outputs[0].kind.value == "angle"
+    plot_response(result, ideal, output, angular=angular, path=out / f"{output}_response_vs_ideal.png")
+    if result.joints:
+        plot_contact_force(result, path=out / "contact_force.png")
+    for j in mech.clearance_joints:
+        plot_orbit(result, j.name, j.clearance.radial_clearance, path=out / f"journal_orbit_{j.name}.png")
+    for r in rows:
+        print(f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
+              f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
+              f"max penetration {r.max_penetration * 1e6:.3g} µm")
+    if rows:
+        unit, scale = ("rad", 1.0) if angular else ("mm", 1e3)
+        print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * scale:.4g} {unit}")
+
+
+def _duration(args, mech) -> float:
+    from clearance.simulation import default_duration
+
+    return args.duration_ms * 1e-3 if args.duration_ms else default_duration(mech, args.revolutions)
+
+
+def _cmd_run(args) -> int:
     from clearance.preparation import prepare
     from clearance.results import atomic_write_text
-    from clearance.simulation import SimulationError, default_duration, simulate_prepared
+    from clearance.simulation import SimulationError, simulate_prepared
 
     mech = _mechanism(args)
     options = _options(args)
-    duration = args.duration_ms * 1e-3 if args.duration_ms else default_duration(mech, args.revolutions)
+    duration = _duration(args, mech)
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     prepared = prepare(mech, options)
@@ -132,31 +178,39 @@ def _cmd_run(args) -> int:
         result = simulate_prepared(prepared, duration=duration, progress=progress)
     except SimulationError as err:
         failed, result = err, err.partial
-    ideal = simulate_prepared(ideal_prepared, duration=duration, progress=progress)
     if result is None:
         print(f"error: {failed}", file=sys.stderr)
         return 2
-    result.save(out / "result")
-    ideal.save(out / "ideal")
-    if args.rerun:
-        from clearance.analysis.rerun_log import record
-
-        print(f"  wrote {record(result, mech, args.rerun, ideal=ideal)}")
-    rows = summarise(result, ideal)
-    write_summary_csv(rows, out / "summary.csv")
-    output = next(iter(o.name for o in mech.outputs))
-    angular = mech.outputs[0].kind.value == "angle"
-    plot_response(result, ideal, output, angular=angular, path=out / f"{output}_response_vs_ideal.png")
-    if result.joints:
-        plot_contact_force(result, path=out / "contact_force.png")
-    for j in mech.clearance_joints:
-        plot_orbit(result, j.name, j.clearance.radial_clearance, path=out / f"journal_orbit_{j.name}.png")
-    for r in rows:
-        print(f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
-              f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
-              f"max penetration {r.max_penetration * 1e6:.3g} µm")
-    print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * 1e3:.4g} mm" if rows else "")
+    ideal = simulate_prepared(ideal_prepared, duration=duration, progress=progress)
+    _write_outputs(args, mech, result, ideal, out)
     print(f"  {result.metadata['steps_per_second']:.3g} steps/s; wrote {out}/")
+    if failed is not None:
+        print(f"error: {failed}", file=sys.stderr)
+        return 2
+    return 0
+
+
+def _cmd_reference(args) -> int:
+    from clearance.reference import ReferenceSolverError, run_reference
+
+    mech = _mechanism(args)
+    duration = _duration(args, mech)
+    out = Path(args.out)
+    out.mkdir(parents=True, exist_ok=True)
+    print(f"{mech.name} (reference solver): clearance at {[j.name for j in mech.clearance_joints]}, "
+          f"{duration * 1e3:.3g} ms, rtol {args.rtol:g}")
+    progress = not args.no_progress
+    failed = None
+    try:
+        result = run_reference(mech, duration, output_interval=args.output_us * 1e-6, rtol=args.rtol, progress=progress)
+    except ReferenceSolverError as err:
+        failed, result = err, getattr(err, "partial", None)
+    if result is None:
+        print(f"error: {failed}", file=sys.stderr)
+        return 2
+    ideal = run_reference(mech.ideal_twin(), duration, output_interval=args.output_us * 1e-6, rtol=args.rtol)
+    _write_outputs(args, mech, result, ideal, out)
+    print(f"  wall time {result.metadata.get('wall_time_s', float('nan')):.3g} s; wrote {out}/")
     if failed is not None:
         print(f"error: {failed}", file=sys.stderr)
         return 2
@@ -173,6 +227,8 @@ def main(argv: list[str] | None = None) -> int:
             return _cmd_run(args)
         if args.command == "mjcf":
             return _cmd_mjcf(args)
+        if args.command == "reference":
+            return _cmd_reference(args)
     except (ValueError, AssemblyError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2

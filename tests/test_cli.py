@@ -42,3 +42,12 @@ def test_bad_values_reported_clearly(tmp_path, capsys):
     rc = main(["run", "--clearance-mm", "20", "--out", str(tmp_path), "--no-progress"])
     assert rc == 2
     assert "radial_clearance" in capsys.readouterr().err
+
+
+def test_reference_command(tmp_path):
+    out = tmp_path / "ref"
+    # 0.4 ms covers the first impact (about 0.25 ms after the start) and stays fast
+    assert main(["reference", "--duration-ms", "0.4", "--out", str(out), "--no-progress"]) == 0
+    rows = list(csv.DictReader((out / "summary.csv").open()))
+    assert float(rows[0]["peak_force"]) > 1e3  # REFERENCES.md section 3: forces of order 1e4 N
+    assert (out / "journal_orbit_rod_slider.png").stat().st_size > 0
