@@ -1,0 +1,261 @@
+"""Exact-LN contact inside MuJoCo: the law's force imposed on the ring's contact rows.
+
+Each step is split (MUJOCO_NOTES.md, "Exact LN inside MuJoCo"): `mj_step1` builds the
+contacts; the journal's penetration δ = |e| − c and rate δ̇ = e·ė/|e| come from its
+eccentricity e in the bearing (exact circle geometry, not the polygon); the law gives one
+force F(δ, δ̇, δ̇⁻), with δ̇⁻ recorded at the first step of each contact; F is shared among
+the ring's active rows (minimum-norm non-negative row forces whose net force on the journal
+is −F e/|e|; CLARIFICATIONS.md: per-row LN would sum to the wrong law); then each row's
+``efc_aref`` is set so that MuJoCo's solver returns exactly those row forces, and
+`mj_step2` integrates.
+
+For a soft constraint with regulariser R the solver's row forces f satisfy
+(A + R) f = aref − J a₀ (A = J M⁻¹ Jᵀ, a₀ the unconstrained acceleration) while they are
+non-negative, so aref = (A + R) f* + J a₀ gives f = f* exactly (the simpler aref = R f*
+errs by about A/R, up to ~1 % with many rows at impedance 1e-3). That is exact when the
+ring's rows are the only constraints; other constraints (loop closures) couple through A.
+
+Pair margins are raised to the polygon's largest gap so that a row exists whenever the
+exact circles touch. Frictionless pairs only (condim 1). The step loop runs in Python, so
+this mode is much slower than `mujoco.rollout` (see benchmarks/calibration_accuracy.md).
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from clearance.contact_calibration.laws import bearing_stiffness, hysteresis_factor
+from clearance.contact_calibration.scene_impact import SceneImpact, _crossing, _peak, onset_radius
+from clearance.mjcf.bearing import RingGeometry
+from clearance.mjcf.probe import ring_scene
+from clearance.model import Clearance, ContactLaw
+from clearance.options import ContactParameters, ModelOptions
+
+__all__ = ["ExactLNContact", "exact_ln_impact", "polygon_margin", "ExactLNCost", "exact_ln_cost"]
+
+_TINY_SPEED = 1e-9  # m/s: floor of the recorded approach speed (grazing onsets)
+
+
+def polygon_margin(ring: RingGeometry) -> float:
+    """Largest radial gap [m] between the bearing circle and the ring's first contact."""
+    psi = np.linspace(0.0, 2 * math.pi / ring.segments, 9)
+    return max(onset_radius(ring, float(p)) for p in psi) - ring.radial_clearance
+
+
+class ExactLNContact:
+    """Imposes the LN force of one clearance joint on its contact rows, step by step.
+
+    Call `apply` between `mujoco.mj_step1` and `mujoco.mj_step2`.
+
+    Args:
+        model: compiled model; its pairs with the journal geom are this joint's rows
+            (their margins are raised in place to cover the polygon gap).
+        clearance: the joint's clearance (law, K, cₑ, radii).
+        ring: the joint's ring geometry.
+        journal_geom: name of the journal geom.
+        bearing_site: name of a site at the bearing centre, or None for a bearing fixed at
+            the world origin (the one-bearing scene).
+
+    Raises:
+        ValueError: the law is IMPACT, or a pair has friction (condim > 1).
+    """
+
+    def __init__(self, model: mujoco.MjModel, clearance: Clearance, ring: RingGeometry, *,
+                 journal_geom: str, bearing_site: str | None = None) -> None:
+        if clearance.law is ContactLaw.IMPACT:
+            raise ValueError("exact-LN mode needs a law with a restitution (not IMPACT)")
+        self.jg = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, journal_geom)
+        if self.jg < 0:
+            raise ValueError(f"no geom named {journal_geom!r}")
+        self.site = -1 if bearing_site is None else mujoco.mj_name2id(
+            model, mujoco.mjtObj.mjOBJ_SITE, bearing_site)
+        pairs = np.flatnonzero((model.pair_geom1 == self.jg) | (model.pair_geom2 == self.jg))
+        if np.any(model.pair_dim[pairs] != 1):
+            raise ValueError("exact-LN mode supports frictionless pairs (condim 1) only")
+        model.pair_margin[pairs] = 1.5 * polygon_margin(ring) + 1e-3 * ring.radial_clearance
+        self.c = clearance.radial_clearance
+        self.k = bearing_stiffness(clearance)
+        self.chi = hysteresis_factor(clearance.law, clearance.restitution)
+        self.approach: float | None = None
+        self.last_force = 0.0
+        self.last_penetration = -math.inf
+
+    def _kinematics(self, model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
+        vel = np.zeros(6)
+        mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_GEOM, self.jg, vel, 0)
+        p, v = data.geom_xpos[self.jg, :2].copy(), vel[3:5].copy()
+        if self.site >= 0:
+            mujoco.mj_objectVelocity(model, data, mujoco.mjtObj.mjOBJ_SITE, self.site, vel, 0)
+            p -= data.site_xpos[self.site, :2]
+            v -= vel[3:5]
+        return p, v
+
+    def force(self, delta: float, rate: float) -> float:
+        """The law's force [N] at δ [m], δ̇ [m/s], updating the contact onset state."""
+        if delta <= 0:
+            self.approach = None
+            return 0.0
+        if self.approach is None:
+            self.approach = max(rate, _TINY_SPEED)
+        return max(self.k * delta**1.5 * (1.0 + self.chi * rate / self.approach), 0.0)
+
+    def apply(self, model: mujoco.MjModel, data: mujoco.MjData) -> float:
+        """Set this joint's rows' reference accelerations; returns the LN force [N]."""
+        e, ed = self._kinematics(model, data)
+        r = float(np.hypot(*e))
+        u = e / r if r > 0 else np.array([1.0, 0.0])
+        delta = r - self.c
+        f_ln = self.force(delta, float(u @ ed))
+        self.last_force, self.last_penetration = f_ln, delta
+        con = data.contact
+        geom = con.geom
+        mine = ((geom[:, 0] == self.jg) | (geom[:, 1] == self.jg)) & (con.efc_address >= 0)
+        if not np.any(mine):
+            return f_ln
+        rows_a = con.efc_address[mine]
+        sign = np.where(geom[mine, 1] == self.jg, 1.0, -1.0)  # force on the journal per unit row force
+        s = (con.frame[mine, :2] * sign[:, None]).T  # (2, m)
+        target = -f_ln * u
+        f, *_ = np.linalg.lstsq(s, target, rcond=1e-10)
+        f = np.maximum(f, 0.0)
+        radial = float(-(s @ f) @ u)
+        f = f * (f_ln / radial) if radial > 0 else np.zeros_like(f)
+        self._impose(model, data, rows_a, f)
+        return f_ln
+
+    @staticmethod
+    def _impose(model: mujoco.MjModel, data: mujoco.MjData, rows: np.ndarray, f: np.ndarray) -> None:
+        nv = model.nv
+        if mujoco.mj_isSparse(model):
+            jac = np.zeros((data.nefc, nv))
+            mujoco.mju_sparse2dense(jac, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr,
+                                    data.efc_J_colind)
+        else:
+            jac = data.efc_J[: data.nefc * nv].reshape(data.nefc, nv)
+        j = jac[rows]
+        minv_jt = np.zeros((len(rows), nv))
+        mujoco.mj_solveM(model, data, minv_jt, j)
+        a = j @ minv_jt.T
+        mujoco.mj_fwdActuation(model, data)
+        mujoco.mj_fwdAcceleration(model, data)
+        aref = (a + np.diag(data.efc_R[rows])) @ f + j @ data.qacc_smooth
+        data.efc_aref[rows] = aref
+
+
+@dataclass(frozen=True)
+class ExactLNCost:
+    """Speed of the exact-LN step loop against `mujoco.rollout` on the same scene.
+
+    Attributes:
+        exact_steps_per_s: Python step loop with `ExactLNContact` [steps/s].
+        rollout_steps_per_s: `mujoco.rollout` with calibrated-style fixed parameters.
+        ratio: rollout / exact [-].
+    """
+
+    exact_steps_per_s: float
+    rollout_steps_per_s: float
+    ratio: float
+
+
+def _scene(clearance: Clearance, ring: RingGeometry, options: ModelOptions, mass: float) -> mujoco.MjModel:
+    # The rows' own stiffness/damping are replaced by efc_aref each step; any value works.
+    return ring_scene(ring, options, ContactParameters(1.0, 0.0, "exact_ln"), mass=mass)
+
+
+def exact_ln_impact(
+    clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
+    speed: float, direction: float = 0.0, max_steps: int | None = None,
+) -> SceneImpact:
+    """A radial impact in the one-bearing scene with exact-LN contact.
+
+    The journal starts two steps before the exact circles touch, moving at ``speed``
+    along ``direction``, and is stepped until it leaves the clearance circle.
+
+    Args:
+        clearance: the joint's clearance (law, K, cₑ).
+        ring: ring geometry.
+        options: model options (time step, geoms, impedance).
+        mass: journal (effective) mass [kg].
+        speed: approach speed v [m/s] > 0.
+        direction: impact direction ψ [rad] in the bearing frame.
+        max_steps: step limit (default: 20 Hertz contact durations).
+
+    Returns:
+        The impact; penetration and duration use the exact circle (δ = |e| − c).
+
+    Raises:
+        RuntimeError: no separation within ``max_steps``.
+    """
+    if not (math.isfinite(speed) and speed > 0):
+        raise ValueError(f"speed must be positive and finite (got {speed!r} m/s)")
+    model = _scene(clearance, ring, options, mass)
+    contact = ExactLNContact(model, clearance, ring, journal_geom="ring__journal")
+    data = mujoco.MjData(model)
+    h = options.timestep
+    u = np.array([math.cos(direction), math.sin(direction)])
+    data.qpos[:2] = (clearance.radial_clearance - 2 * speed * h) * u
+    data.qvel[:2] = speed * u
+    d_hertz = (1.25 * mass * speed**2 / contact.k) ** 0.4
+    n = max_steps or int(20 * 2.94 * d_hertz / speed / h) + 10
+    delta, force, vel = [], [], []
+    for _ in range(n):
+        mujoco.mj_step1(model, data)
+        force.append(contact.apply(model, data))
+        delta.append(contact.last_penetration)
+        mujoco.mj_step2(model, data)
+        vel.append(float(data.qvel[:2] @ u))
+        if len(delta) > 3 and delta[-1] <= 0 and max(delta) > 0 and delta[-2] > 0:
+            break
+    else:
+        raise RuntimeError(f"no separation within {n} steps at v = {speed:g} m/s")
+    dl, fl = np.array(delta), np.array(force)
+    on = int(np.argmax(dl > 0))
+    off = len(dl) - 1
+    t_on = (on - 1 + _crossing(dl[on - 1], dl[on])) * h
+    t_off = (off - 1 + _crossing(dl[off - 1], dl[off])) * h
+    return SceneImpact(
+        speed=float(speed), direction=float(direction), times=np.arange(len(dl)) * h - t_on,
+        penetration=dl, force=fl, peak_force=_peak(fl)[0], max_penetration=_peak(dl)[0],
+        duration=t_off - t_on, restitution=-vel[-1] / speed,
+    )
+
+
+def exact_ln_cost(
+    clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
+    params: ContactParameters, load: float = 1000.0, nstep: int = 20000,
+) -> ExactLNCost:
+    """Measure steps/s of the exact-LN loop and of `mujoco.rollout` on the scene.
+
+    Both run ``nstep`` steps, one thread, with the journal pressed into the ring by a
+    constant ``load`` [N] (as a gravity field on the journal) so that contact rows are
+    active throughout: the contact-heavy case, where exact-LN costs most.
+    """
+    import mujoco.rollout
+
+    model = _scene(clearance, ring, options, mass)
+    contact = ExactLNContact(model, clearance, ring, journal_geom="ring__journal")
+    model.opt.gravity[:] = [load / mass, 0.0, 0.0]
+    data = mujoco.MjData(model)
+    data.qvel[:2] = [0.0, 0.3]
+    t0 = time.perf_counter()
+    for _ in range(nstep):
+        mujoco.mj_step1(model, data)
+        contact.apply(model, data)
+        mujoco.mj_step2(model, data)
+    exact = nstep / (time.perf_counter() - t0)
+    fixed = ring_scene(ring, options, params, mass=mass)
+    fixed.opt.gravity[:] = [load / mass, 0.0, 0.0]
+    d2 = mujoco.MjData(fixed)
+    d2.qvel[:2] = [0.0, 0.3]
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    s0 = np.zeros(mujoco.mj_stateSize(fixed, spec))
+    mujoco.mj_getState(fixed, d2, s0, spec)
+    t0 = time.perf_counter()
+    mujoco.rollout.rollout(fixed, d2, s0[None], nstep=nstep)
+    roll = nstep / (time.perf_counter() - t0)
+    return ExactLNCost(exact, roll, roll / exact)

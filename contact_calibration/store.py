@@ -1,0 +1,251 @@
+"""Calibration files: JSON keyed by every input they depend on, in a cache directory.
+
+The directory is ``$CLEARANCE_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/clearance`` or
+``~/.cache/clearance``; calibrations live in its ``calibration/`` subfolder. A file is
+named by the SHA-256 of its canonical key (geometry, materials, law, restitution,
+friction, effective mass and its range, fit speeds, time step, integrator, impedance,
+segment count and shape, geom types, MuJoCo version, fit version) and stores that key, so
+a hash collision or an edited file is detected.
+
+Writes are atomic (a temporary file in the same folder, then `os.replace`), so concurrent
+sweep workers never read half a file: at worst two workers fit the same case and the last
+rename wins with identical content. A file that cannot be read, parsed or validated is
+reported with a `CalibrationCacheWarning` naming it, and rebuilt, never used.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import tempfile
+import warnings
+from pathlib import Path
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from clearance.contact_calibration.fit import (
+    FIT_VERSION,
+    CalibrationResult,
+    default_speeds,
+    fit_contact,
+)
+from clearance.mjcf.bearing import RingGeometry
+from clearance.model import Clearance, Joint
+from clearance.options import ContactParameters, ModelOptions
+
+__all__ = [
+    "CACHE_ENV",
+    "CalibrationCacheWarning",
+    "cache_dir",
+    "calibration_key",
+    "calibration_path",
+    "load_calibration",
+    "save_calibration",
+    "calibrate",
+    "calibrated_parameters",
+]
+
+CACHE_ENV = "CLEARANCE_CACHE_DIR"
+"""Environment variable naming the cache directory."""
+
+
+class CalibrationCacheWarning(UserWarning):
+    """A calibration file was unreadable or inconsistent and is being rebuilt."""
+
+
+def cache_dir() -> Path:
+    """The calibration folder: ``$CLEARANCE_CACHE_DIR/calibration`` (or the user cache)."""
+    root = os.environ.get(CACHE_ENV)
+    if not root:
+        xdg = os.environ.get("XDG_CACHE_HOME")
+        root = os.path.join(xdg, "clearance") if xdg else os.path.join(Path.home(), ".cache", "clearance")
+    return Path(root) / "calibration"
+
+
+def calibration_key(
+    clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
+    mass_range: tuple[float, float], speeds: np.ndarray,
+) -> dict[str, Any]:
+    """Everything a calibration depends on, as a JSON-ready dict (floats kept exact).
+
+    Args:
+        clearance: the joint's clearance (geometry, materials, law, cₑ, friction).
+        ring: ring geometry (segments, segment radius, contacts per pair).
+        options: model options (time step, integrator, geoms, impedance).
+        mass: effective mass fitted at [kg].
+        mass_range: (min, max) effective mass [kg].
+        speeds: fit speeds [m/s].
+
+    Returns:
+        The key.
+    """
+    mat = lambda m: [float(m.youngs_modulus), float(m.poisson_ratio)]  # noqa: E731
+    return {
+        "bearing_radius": float(clearance.bearing_radius),
+        "radial_clearance": float(clearance.radial_clearance),
+        "bearing_material": mat(clearance.bearing_material),
+        "journal_material": mat(clearance.journal_material),
+        "law": clearance.law.value,
+        "restitution": float(clearance.restitution),
+        "friction": float(clearance.friction),
+        "effective_mass": float(mass),
+        "mass_range": [float(x) for x in mass_range],
+        "speeds": [float(v) for v in speeds],
+        "timestep": float(options.timestep),
+        "integrator": options.integrator,
+        "impedance": float(options.impedance),
+        "segments": int(ring.segments),
+        "segment_radius": float(ring.segment_radius),
+        "contacts_per_pair": int(ring.contacts_per_pair),
+        "journal_geom": options.journal_geom.value,
+        "segment_geom": options.segment_geom.value,
+        "mujoco": mujoco.__version__,
+        "fit_version": FIT_VERSION,
+    }
+
+
+def _digest(key: dict[str, Any]) -> str:
+    text = json.dumps(key, sort_keys=True, separators=(",", ":"))
+    return hashlib.sha256(text.encode()).hexdigest()
+
+
+def calibration_path(key: dict[str, Any], directory: Path | None = None) -> Path:
+    """File of a calibration key: ``<cache_dir>/<sha256[:24]>.json``."""
+    return (directory or cache_dir()) / f"calib-{_digest(key)[:24]}.json"
+
+
+def _validate(result: CalibrationResult) -> None:
+    p = result.parameters
+    values = [p.stiffness, p.damping, result.mass, *result.mass_range]
+    if not all(isinstance(v, float) and math.isfinite(v) for v in values) or p.stiffness <= 0:
+        raise ValueError("non-finite or non-positive parameters")
+
+
+def load_calibration(key: dict[str, Any], directory: Path | None = None) -> CalibrationResult | None:
+    """The stored calibration for ``key``, or None when missing or unusable.
+
+    An unusable file (bad JSON, wrong key, missing or non-finite fields) is reported with
+    a `CalibrationCacheWarning` naming the file, and None is returned so it gets rebuilt.
+    """
+    path = calibration_path(key, directory)
+    try:
+        raw = path.read_bytes()
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        raw, error = None, exc
+    try:
+        if raw is None:
+            raise error
+        doc = json.loads(raw.decode("utf-8"))
+        if doc.get("key") != key:
+            raise ValueError("its key does not match the requested inputs")
+        result = CalibrationResult.from_dict(doc["result"])
+        _validate(result)
+    except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
+        warnings.warn(
+            f"calibration file {path} is corrupt or inconsistent ({type(exc).__name__}: "
+            f"{exc}); ignoring it and recalibrating", CalibrationCacheWarning, stacklevel=3,
+        )
+        return None
+    return result
+
+
+def save_calibration(key: dict[str, Any], result: CalibrationResult, directory: Path | None = None) -> Path:
+    """Write a calibration atomically (temporary file + `os.replace`); returns its path."""
+    path = calibration_path(key, directory)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    text = json.dumps({"key": key, "result": result.to_dict()}, indent=1, sort_keys=True)
+    fd, tmp = tempfile.mkstemp(prefix=path.stem + ".", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8") as f:
+            f.write(text)
+            f.flush()
+            os.fsync(f.fileno())
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+    return path
+
+
+def calibrate(
+    clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
+    impact_speed: float | None = None, speeds: np.ndarray | None = None,
+    mass_range: tuple[float, float] | None = None, max_penetration: float | None = None,
+    use_cache: bool = True,
+) -> tuple[CalibrationResult, Path | None]:
+    """Calibrate one bearing, reusing a stored calibration with the same inputs.
+
+    Args:
+        clearance: the joint's clearance.
+        ring: ring geometry.
+        options: model options.
+        mass: effective mass [kg] (median over the cycle).
+        impact_speed: sizing impact speed [m/s]; gives `default_speeds` when ``speeds``
+            is None.
+        speeds: fit speeds [m/s] (overrides ``impact_speed``).
+        mass_range: (min, max) effective mass over the cycle [kg].
+        max_penetration: largest expected penetration for the stability check [m]
+            (checked on every call, also for a stored calibration).
+        use_cache: read and write the cache.
+
+    Returns:
+        The calibration and its file (None without cache).
+
+    Raises:
+        ValueError: neither speeds nor impact_speed given, or bad arguments.
+        CalibrationStabilityError: the parameters are unstable at the time step.
+    """
+    from clearance.contact_calibration.fit import check_stability
+
+    if speeds is None:
+        if impact_speed is None:
+            raise ValueError("give impact_speed [m/s] or speeds [m/s]")
+        speeds = default_speeds(impact_speed)
+    speeds = np.sort(np.asarray(speeds, dtype=float))
+    mrange = tuple(mass_range) if mass_range else (float(mass), float(mass))
+    key = calibration_key(clearance, ring, options, mass=mass, mass_range=mrange, speeds=speeds)
+    if use_cache:
+        hit = load_calibration(key)
+        if hit is not None:
+            if max_penetration is not None:
+                check_stability(ring, hit.parameters, mass=mass, timestep=options.timestep,
+                                max_penetration=max_penetration)
+            return hit, calibration_path(key)
+    result = fit_contact(clearance, ring, options, mass=mass, speeds=speeds, mass_range=mrange,
+                         max_penetration=max_penetration)
+    return result, (save_calibration(key, result) if use_cache else None)
+
+
+def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Any, options: ModelOptions) -> ContactParameters:
+    """Calibrated per-row contact parameters of a clearance joint (cached).
+
+    The entry point of `ContactMode.CALIBRATED` in `clearance.preparation`.
+
+    Args:
+        joint: the clearance joint.
+        ring: its ring geometry.
+        sizing: its `JointSizing` (effective_mass [kg], impact_speed [m/s],
+            penetration_limit [m] are used).
+        options: model options.
+
+    Returns:
+        ContactParameters with source ``"calibrated: <file>"``.
+
+    Raises:
+        CalibrationStabilityError: the fitted contact is unstable at the time step.
+    """
+    if joint.clearance is None:
+        raise ValueError(f"joint '{joint.name}' has no clearance to calibrate")
+    mass = float(sizing.effective_mass)
+    mrange = getattr(sizing, "effective_mass_range", None)
+    result, path = calibrate(joint.clearance, ring, options, mass=mass,
+                             impact_speed=float(sizing.impact_speed), mass_range=mrange,
+                             max_penetration=float(sizing.penetration_limit))
+    p = result.parameters
+    return ContactParameters(p.stiffness, p.damping, f"calibrated: {path}")
