@@ -7,8 +7,8 @@ this criterion (`classify_poincare`):
 1. Distinct points: the points are grouped greedily (a point joins the first group whose
    first member lies within ``tol`` times ``scale``, by default the set's RMS radius about
    its centroid; pass the RMS radius of the whole trajectory for a robust test). At most
-   ``max_period`` groups means PERIODIC with period = number of groups (a set with an RMS
-   radius below ``atol`` is period 1).
+   ``max_period`` groups, each visited at least twice (K >= 2 x groups), means PERIODIC
+   with period = number of groups (a set with an RMS radius below ``atol`` is period 1).
 2. Otherwise nearest-neighbour divergence of the section map: for every point k with a
    successor, take its nearest other point j (also with a successor) and the log ratio
    ln(|P[k+1] - P[j+1]| / |P[k] - P[j]|). On an invariant closed curve
@@ -317,7 +317,7 @@ def classify_poincare(
     if rms <= atol:
         return PoincareClassification(Regime.PERIODIC, len(p), 1, 1, float("nan"), float("nan"))
     groups = _distinct(p, tol * (rms if scale is None else scale), max_period)
-    if groups <= max_period:
+    if groups <= max_period and len(p) >= 2 * groups:  # each group revisited at least once
         return PoincareClassification(Regime.PERIODIC, len(p), groups, groups, float("nan"), float("nan"))
     div = map_divergence(p)
     dim = correlation_dimension(p)

@@ -1,0 +1,144 @@
+"""Bifurcation and criticality sweeps, figures, the Markdown report and the CLI entry points."""
+
+from __future__ import annotations
+
+from concurrent.futures import Future
+
+import numpy as np
+import pytest
+
+from clearance.analysis.bifurcation import BifurcationDiagram, bifurcation_from_rows, run_bifurcation
+from clearance.analysis.cli_commands import main_rank, main_sweep
+from clearance.analysis.criticality import (
+    ClearanceAtJoint,
+    criticality_candidates,
+    rank_joints,
+    ranking_markdown,
+    run_criticality,
+)
+from clearance.analysis.sweep import KeywordFactory
+from clearance.builders import rpm, slider_crank
+from clearance.options import ModelOptions
+
+# low speed and a coarse step keep each run well under a second (1000 rpm: T = 60 ms)
+OPTIONS = ModelOptions(timestep=5e-6, segments=36)
+
+
+class _Inline:
+    """Executor running each call at submit (no process start-up in these tests)."""
+
+    def submit(self, fn, *args):
+        f = Future()
+        f.set_result(fn(*args))
+        return f
+
+
+def test_bifurcation_sweep_and_figure(tmp_path):
+    make = KeywordFactory(slider_crank, fixed={"crank_speed": rpm(1000.0)})
+    values = [0.1e-3, 0.5e-3]
+    d = run_bifurcation(values, make, out_dir=tmp_path, quantity="rod_slider.ex", periods=4, sampled=2,
+                        options=OPTIONS, executor=_Inline(), progress=False)
+    np.testing.assert_array_equal(d.values, values)
+    assert d.quantity == "rod_slider.ex" and d.errors == ("", "")
+    # sections at t = 2T and 3T: the run ends one step before 4T
+    assert [len(s) for s in d.samples] == [2, 2]
+    # the journal stays within its clearance circle plus penetration (< 0.1 mm here)
+    assert all(np.all(np.abs(s) < c + 0.1e-3) for s, c in zip(d.samples, values))
+    from clearance.analysis.figures import plot_bifurcation
+
+    png = tmp_path / "bif.png"
+    plot_bifurcation(d, path=png)
+    assert png.stat().st_size > 5000
+    with pytest.raises(ValueError, match="sampled"):
+        run_bifurcation(values, make, out_dir=tmp_path / "x", periods=4, sampled=4, executor=_Inline())
+
+
+def test_bifurcation_from_rows_marks_failed_points():
+    rows = [
+        {"index": 0, "point": {"c": 1.0}, "status": "ok", "error": "",
+         "poincare": {"quantities": ["q"], "points": [[1.0], [2.0]], "regime": "periodic"}},
+        {"index": 1, "point": {"c": 2.0}, "status": "error", "error": "TimeStepError: x"},
+    ]
+    d = bifurcation_from_rows(rows, "c")
+    assert d.regimes == ("periodic", "error") and d.quantity == "q"
+    x, y = d.scatter()
+    np.testing.assert_array_equal(x, [1.0, 1.0])
+    np.testing.assert_array_equal(y, [1.0, 2.0])
+
+
+def test_criticality_candidates_and_sweep(tmp_path):
+    assert criticality_candidates(slider_crank(clearance_at=())) == ["crank_rod", "rod_slider"]
+    r = run_criticality(ClearanceAtJoint(slider_crank), clearances=[0.5e-3], speeds=[rpm(1000.0)], periods=3,
+                        out_dir=tmp_path, options=OPTIONS, executor=_Inline(), progress=False)
+    assert {s.joint for s in r.scores} == {"crank_rod", "rod_slider"}
+    assert [s.rank for s in r.scores] == [1, 2]
+    for s in r.scores:
+        # the output moves at most by c plus penetration relative to ideal: ratio <= ~1.1
+        assert 0 < s.score < 1.1
+        assert s.ci_low <= s.score <= s.ci_high
+    assert len(r.cells) == 2 and all(c.cycles == 2 for c in r.cells)
+    md = ranking_markdown(r)
+    assert "| 1 |" in md and "rod_slider" in md
+    from clearance.analysis.figures import plot_criticality
+
+    plot_criticality(r, path=tmp_path / "crit.png")
+    assert (tmp_path / "crit.png").stat().st_size > 5000
+
+
+def _row(i, joint, c, cycles):
+    return {"index": i, "status": "ok", "error": "", "point": {"joint": joint, "clearance": c, "speed": 100.0},
+            "per_cycle_mean_deviation": cycles}
+
+
+def test_rank_joints_scores_and_confidence():
+    rows = [
+        _row(0, "a", 1e-4, [0.5e-4, 0.5e-4, 0.5e-4]),  # ratio 0.5, no scatter
+        _row(1, "a", 2e-4, [1.0e-4, 1.2e-4, 0.8e-4]),  # ratio 0.5 +- 0.058 (s.e.)
+        _row(2, "b", 1e-4, [0.2e-4, 0.3e-4, 0.1e-4]),  # ratio 0.2 +- 0.058
+        _row(3, "b", 2e-4, [0.4e-4, 0.4e-4, 0.4e-4]),  # ratio 0.2
+        {"index": 4, "status": "error", "error": "boom", "point": {"joint": "c", "clearance": 1e-4, "speed": 100.0}},
+    ]
+    r = rank_joints(rows)
+    a, b = r.scores
+    assert (a.joint, b.joint) == ("a", "b")
+    # means of the per-cell ratios; identical arithmetic: 1e-12 relative
+    assert a.score == pytest.approx(0.5, rel=1e-12) and b.score == pytest.approx(0.2, rel=1e-12)
+    se = np.std([0.5, 0.6, 0.4], ddof=1) / np.sqrt(3) / 2  # one cell with scatter, averaged over 2 cells
+    assert a.se == pytest.approx(se, rel=1e-12)
+    assert a.confidence_above_next > 0.99  # 0.3 apart with s.e. ~0.04 each
+    assert np.isnan(b.confidence_above_next)
+    assert r.failed and r.failed[0][1] == "boom"
+    with pytest.raises(ValueError, match="nothing to rank"):
+        rank_joints(rows[4:])
+
+
+def test_report_writes_markdown_and_figures(tmp_path):
+    from clearance import simulate
+    from clearance.analysis.report import write_report
+
+    m = slider_crank(crank_speed=rpm(1000.0))
+    res, ideal = simulate(m, options=OPTIONS), simulate(m.ideal_twin(), options=OPTIONS)
+    diag = BifurcationDiagram("radial_clearance", "rod_slider.ex", np.array([1e-4, 2e-4]),
+                              (np.array([1e-5, 2e-5]), np.zeros(0)), ("periodic", "error"), ("", "boom"))
+    ranking = rank_joints([_row(0, "a", 1e-4, [0.5e-4, 0.6e-4]), _row(1, "b", 1e-4, [0.2e-4, 0.3e-4])])
+    path = write_report(tmp_path, res, ideal, bifurcation=diag, ranking=ranking)
+    text = path.read_text()
+    for heading in ("Response against the ideal", "Deviation statistics", "Contact at the clearance joints",
+                    "Poincaré sections", "Bifurcation diagram", "Joint criticality"):
+        assert heading in text
+    for png in ("response_vs_ideal", "deviation", "contact_force", "contact_modes", "orbit_rod_slider",
+                "phase_0", "bifurcation", "criticality"):
+        assert (tmp_path / f"{png}.png").exists() and f"({png}.png)" in text
+
+
+def test_cli_sweep_and_rank(tmp_path, capsys):
+    common = ["--rpm", "1000", "--timestep-us", "5", "--segments", "36", "--workers", "1", "--no-progress"]
+    rc = main_sweep(["--points", "2", "--start", "0.2", "--stop", "0.5", "--periods", "3", "--sampled", "1",
+                     "--out", str(tmp_path / "s"), *common])
+    assert rc == 0 and (tmp_path / "s" / "bifurcation.png").exists() and (tmp_path / "s" / "sweep.csv").exists()
+    rc = main_rank(["--clearances-mm", "0.5", "--joints", "rod_slider", "--periods", "3",
+                    "--out", str(tmp_path / "r"), *common])
+    assert rc == 0 and "rod_slider" in (tmp_path / "r" / "ranking.md").read_text()
+    assert "rod_slider" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main_sweep(["--mechanism", "no_such", "--out", str(tmp_path / "x")])
