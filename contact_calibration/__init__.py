@@ -64,6 +64,7 @@ _LAZY = {
     "default_speeds": "fit",
     "reference_impacts": "fit",
     "evaluate": "fit",
+    "accuracy_rows": "fit",
     "check_stability": "fit",
     "fit_contact": "fit",
     # store
@@ -89,6 +90,7 @@ _LAZY = {
     "calibration_report": "report",
     "accuracy_table": "report",
     "main_calibrate": "report",
+    "ReportFiles": "report",
 }
 
 __all__ = [

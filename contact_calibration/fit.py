@@ -52,6 +52,7 @@ __all__ = [
     "default_speeds",
     "reference_impacts",
     "evaluate",
+    "accuracy_rows",
     "check_stability",
     "fit_contact",
 ]
@@ -252,6 +253,17 @@ def _rows(speeds: np.ndarray, err: np.ndarray, refs: list[ImpactResult]) -> tupl
         out.append(SpeedRow(float(v), r.peak_force, r.max_penetration, r.duration, r.restitution,
                             *(float(x) for pair in zip(mean, worst) for x in pair)))
     return tuple(out)
+
+
+def accuracy_rows(
+    clearance: Clearance, ring: RingGeometry, options: ModelOptions, params: ContactParameters,
+    *, mass: float, speeds: np.ndarray, directions: np.ndarray | None = None,
+) -> tuple[SpeedRow, ...]:
+    """Accuracy of ``params`` against the reference at any ``speeds`` [m/s] (see `evaluate`)."""
+    speeds = np.asarray(speeds, dtype=float)
+    err, _, refs = evaluate(clearance, ring, options, params, mass=mass, speeds=speeds,
+                            directions=directions)
+    return _rows(speeds, err, refs)
 
 
 def check_stability(

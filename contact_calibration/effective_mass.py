@@ -1,0 +1,170 @@
+"""Effective mass at each bearing over one cycle of the ideal mechanism.
+
+The mass a journal impact sees along the contact normal n is 1 / (nᵀ A n), with
+A = J W Jᵀ: J the relative translation Jacobian of journal and bearing centres (xy) and W
+the inverse mass matrix of the compiled model restricted by its other constraints:
+W = M⁻¹ − M⁻¹ Gᵀ (G M⁻¹ Gᵀ)⁺ G M⁻¹, where G holds the loop-closure equality rows and,
+for velocity-driven cranks, the driven joint (a velocity actuator with kv·h ≫ inertia holds
+the crank speed through an impact: its time constant I/kv is ~1e-9 s against ~50 µs
+contacts). At each pose the direction-median of 1/(nᵀ A n) is taken, as in
+`clearance.mjcf.effective_masses` (which uses qpos0 only and omits G).
+
+Poses come from the exact ideal kinematics (`clearance.kinematics.solve_kinematics`) over
+one drive period, mapped onto the model's qpos by Gauss–Newton on the body frames.
+CLARIFICATIONS.md: fit at the median over the cycle, keep min–max as the valid range.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from clearance.kinematics import solve_kinematics
+from clearance.mjcf.spec import BuiltModel
+from clearance.model import DriveKind, Mechanism
+
+__all__ = ["EffectiveMass", "cycle_effective_mass"]
+
+
+@dataclass(frozen=True)
+class EffectiveMass:
+    """Effective mass of one bearing over the cycle.
+
+    Attributes:
+        median: median over the cycle [kg] (the value to calibrate at).
+        minimum: smallest over the cycle [kg].
+        maximum: largest over the cycle [kg].
+        times: (n,) sample times [s].
+        values: (n,) direction-median effective mass at each time [kg].
+    """
+
+    median: float
+    minimum: float
+    maximum: float
+    times: np.ndarray
+    values: np.ndarray
+
+    @property
+    def valid_range(self) -> tuple[float, float]:
+        """(minimum, maximum) [kg]."""
+        return (self.minimum, self.maximum)
+
+
+def _body_pose(data: mujoco.MjData, bid: int) -> np.ndarray:
+    q = data.xquat[bid]
+    return np.array([data.xpos[bid, 0], data.xpos[bid, 1], 2 * math.atan2(q[3], q[0])])
+
+
+def _set_pose(model: mujoco.MjModel, data: mujoco.MjData, bids: list[int], target: np.ndarray) -> float:
+    """Gauss-Newton on qpos so the bodies' (x, y, θ) match ``target`` (n_b, 3); returns residual."""
+    jp, jr = np.zeros((3, model.nv)), np.zeros((3, model.nv))
+    res = math.inf
+    for _ in range(30):
+        mujoco.mj_kinematics(model, data)
+        mujoco.mj_comPos(model, data)
+        rows, err = [], []
+        for bid, t in zip(bids, target):
+            p = _body_pose(data, bid)
+            d = t - p
+            d[2] = (d[2] + math.pi) % (2 * math.pi) - math.pi
+            mujoco.mj_jacBody(model, data, jp, jr, bid)
+            rows += [jp[0].copy(), jp[1].copy(), jr[2].copy()]
+            err += list(d)
+        err_a = np.array(err)
+        res = float(np.max(np.abs(err_a)))
+        if res < 1e-12:
+            break
+        dq, *_ = np.linalg.lstsq(np.array(rows), err_a, rcond=None)
+        mujoco.mj_integratePos(model, data.qpos, dq, 1.0)
+    return res
+
+
+def _constraint_rows(model: mujoco.MjModel, data: mujoco.MjData, mechanism: Mechanism,
+                     lock_drives: bool) -> np.ndarray:
+    rows = []
+    eq = data.efc_type[: data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
+    if np.any(eq):
+        jac = np.zeros((data.nefc, model.nv))
+        if mujoco.mj_isSparse(model):
+            mujoco.mju_sparse2dense(jac, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr,
+                                    data.efc_J_colind)
+        else:
+            jac = data.efc_J[: data.nefc * model.nv].reshape(data.nefc, model.nv)
+        rows += list(jac[eq])
+    for d in mechanism.drives:
+        if d.kind is DriveKind.TORQUE or not lock_drives:
+            continue
+        jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, d.joint)
+        if jid >= 0:
+            r = np.zeros(model.nv)
+            r[model.jnt_dofadr[jid]] = 1.0
+            rows.append(r)
+    return np.array(rows).reshape(-1, model.nv)
+
+
+def _bearing_mass(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndarray,
+                  n_dir: int) -> float:
+    nv = model.nv
+    minv = np.zeros((nv, nv))
+    mujoco.mj_solveM(model, data, minv, np.eye(nv))
+    w = minv
+    if len(g):
+        gm = g @ minv
+        w = minv - gm.T @ np.linalg.pinv(gm @ g.T, rcond=1e-10) @ gm
+    jac = np.zeros((2, 3, nv))
+    for k, site in enumerate((f"{joint}__journal", f"{joint}__bearing")):
+        sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, site)
+        mujoco.mj_jacSite(model, data, jac[k], None, sid)
+    jrel = (jac[0] - jac[1])[:2]
+    a = jrel @ w @ jrel.T
+    ang = np.linspace(0, np.pi, n_dir, endpoint=False)
+    n = np.stack([np.cos(ang), np.sin(ang)], axis=1)
+    inv = np.einsum("ni,ij,nj->n", n, a, n)
+    return float(np.median(1.0 / np.maximum(inv, 1e-300)))
+
+
+def cycle_effective_mass(
+    model: mujoco.MjModel, built: BuiltModel, mechanism: Mechanism, *, n_poses: int = 36,
+    n_dir: int = 36, lock_velocity_drives: bool = True,
+) -> dict[str, EffectiveMass]:
+    """Effective mass at every clearance joint over one drive period of the ideal cycle.
+
+    Args:
+        model: the compiled clearance model (``prepare(...).model``).
+        built: its `BuiltModel` (body tree, rings, link order).
+        mechanism: the mechanism.
+        n_poses: poses over one period (uniform in time).
+        n_dir: normal directions per pose (median over them).
+        lock_velocity_drives: treat constant-speed and servo drives as locked during an
+            impact (see the module docstring); torque drives are never locked.
+
+    Returns:
+        joint name -> `EffectiveMass`.
+
+    Raises:
+        RuntimeError: a cycle pose cannot be reproduced in the model's coordinates.
+    """
+    periods = [d.period for d in mechanism.drives if d.kind is not DriveKind.TORQUE]
+    period = max(periods) if periods else 1.0
+    times = np.linspace(0.0, period, n_poses, endpoint=False)
+    kin = solve_kinematics(mechanism, times)
+    names = [lk.name for lk in mechanism.moving_links]
+    bids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in names]
+    data = mujoco.MjData(model)
+    data.qpos[:] = model.qpos0
+    out = {j: np.zeros(n_poses) for j in built.rings}
+    for i, q in enumerate(kin.q):
+        res = _set_pose(model, data, bids, q.reshape(-1, 3))
+        if res > 1e-8:
+            raise RuntimeError(f"cycle pose at t = {times[i]:g} s not reproduced (residual {res:.3g})")
+        data.qvel[:] = 0
+        mujoco.mj_forward(model, data)
+        g = _constraint_rows(model, data, mechanism, lock_velocity_drives)
+        for j in built.rings:
+            out[j][i] = _bearing_mass(model, data, j, g, n_dir)
+    return {j: EffectiveMass(float(np.median(v)), float(v.min()), float(v.max()), times, v)
+            for j, v in out.items()}
+

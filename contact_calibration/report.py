@@ -1,0 +1,230 @@
+"""Calibration reports (Markdown table + force–time plot) and the `clearance calibrate` command.
+
+`calibration_report` writes ``<stem>.md`` (parameters, stability, accuracy per speed with
+the goals marked) and ``<stem>.png`` (MuJoCo against LN force–time curves at several
+speeds, both impact directions, plus exact-LN when asked). `main_calibrate(argv)` is the
+command behind ``clearance calibrate``; it returns a process exit status.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import tempfile
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Sequence
+
+import numpy as np
+
+from clearance.contact_calibration.fit import GOALS, CalibrationResult, SpeedRow, evaluate
+from clearance.mjcf.bearing import RingGeometry
+from clearance.model import Clearance
+from clearance.options import ModelOptions
+
+__all__ = ["ReportFiles", "accuracy_table", "calibration_report", "main_calibrate"]
+
+
+@dataclass(frozen=True)
+class ReportFiles:
+    """Files written by `calibration_report`."""
+
+    markdown: Path
+    plot: Path
+
+
+def _mark(value: float, goal: float, pct: bool) -> str:
+    text = f"{value * 100:+.2f} %" if pct else f"{value:+.4f}"
+    return text if abs(value) <= goal else f"**{text}**"
+
+
+def accuracy_table(rows: Sequence[SpeedRow]) -> str:
+    """Markdown table of MuJoCo-vs-LN errors per speed (bold: outside `GOALS`).
+
+    Each cell gives the direction mean and, in brackets, the worst direction.
+    """
+    head = ("| v [m/s] | LN peak F [N] | LN δmax [µm] | LN T [µs] | LN e | peak F err | δmax err "
+            "| T err | e − e_LN | goals |\n|---|---|---|---|---|---|---|---|---|---|\n")
+    lines = []
+    for r in rows:
+        cells = [
+            f"{_mark(r.peak_force_err, GOALS['peak_force'], True)} ({_mark(r.peak_force_worst, GOALS['peak_force'], True)})",
+            f"{_mark(r.max_penetration_err, GOALS['max_penetration'], True)} ({_mark(r.max_penetration_worst, GOALS['max_penetration'], True)})",
+            f"{_mark(r.duration_err, GOALS['duration'], True)} ({_mark(r.duration_worst, GOALS['duration'], True)})",
+            f"{_mark(r.restitution_err, GOALS['restitution'], False)} ({_mark(r.restitution_worst, GOALS['restitution'], False)})",
+        ]
+        lines.append(
+            f"| {r.speed:.3g} | {r.ln_peak_force:.4g} | {r.ln_max_penetration * 1e6:.3g} | "
+            f"{r.ln_duration * 1e6:.3g} | {r.ln_restitution:.4f} | " + " | ".join(cells)
+            + f" | {'met' if r.meets_goals() else 'missed'} |"
+        )
+    return head + "\n".join(lines) + "\n"
+
+
+def _atomic_write(path: Path, data: bytes) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
+    try:
+        with os.fdopen(fd, "wb") as f:
+            f.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def _markdown(result: CalibrationResult, clearance: Clearance, ring: RingGeometry,
+              options: ModelOptions, title: str, source: str | None) -> str:
+    p, s = result.parameters, result.stability
+    met = sum(r.meets_goals() for r in result.rows)
+    lo, hi = result.mass_range
+    return (
+        f"# {title}\n\n"
+        f"- Bearing: R_B = {clearance.bearing_radius * 1e3:g} mm, c = {clearance.radial_clearance * 1e3:g} mm, "
+        f"law {clearance.law.value}, cₑ = {clearance.restitution:g}, μ = {clearance.friction:g}\n"
+        f"- Ring: N = {ring.segments}, {options.journal_geom.value} journal / {options.segment_geom.value} "
+        f"segments, time step {options.timestep * 1e6:g} µs, {options.integrator}, impedance {options.impedance:g}\n"
+        f"- Effective mass {result.mass:.5g} kg (valid range {lo:.5g}–{hi:.5g} kg)\n"
+        f"- Fitted per-row stiffness {p.stiffness:.6g} N/m, damping {p.damping:.6g} N·s/m "
+        f"(nominal start {result.initial.stiffness:.6g} N/m, {result.initial.damping:.6g} N·s/m); "
+        f"emitted as direct-mode solref (−k·Â, −b·Â), solimp unchanged\n"
+        f"- Stability at δ = {s.penetration * 1e6:.3g} µm: ω·h = {s.omega_h:.3f} (< 2), "
+        f"h²ω² + 2hβ = {s.damped_bound:.3f} (< 4)\n"
+        f"- Fit: {result.nfev} MuJoCo evaluations, {result.wall_time:.2f} s; MuJoCo {result.meta.get('mujoco')}\n"
+        + (f"- Calibration file: `{source}`\n" if source else "")
+        + f"\nGoals: peak force and max penetration within {GOALS['peak_force']:.0%}, duration within "
+        f"{GOALS['duration']:.0%}, restitution within {GOALS['restitution']} of the LN impact's own. "
+        f"Cells: mean over impact directions (worst direction); bold = outside the goal. "
+        f"{met} of {len(result.rows)} speeds meet all goals.\n\n"
+        + accuracy_table(result.rows)
+    )
+
+
+def _plot(result: CalibrationResult, clearance: Clearance, ring: RingGeometry,
+          options: ModelOptions, speeds: np.ndarray, path: Path, exact: bool) -> None:
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    err, imps, refs = evaluate(clearance, ring, options, result.parameters, mass=result.mass,
+                               speeds=speeds, directions=np.array(result.directions))
+    fig, axes = plt.subplots(1, len(speeds), figsize=(4.2 * len(speeds), 3.6), squeeze=False)
+    for ax, v, row, ref in zip(axes[0], speeds, imps, refs):
+        ax.plot(ref.times * 1e6, ref.force, "k-", lw=2, label="LN reference")
+        for imp, style in zip(row, ("C0--", "C1:")):
+            frac = imp.direction * ring.segments / (2 * math.pi)
+            ax.plot(imp.times * 1e6, imp.force, style, lw=1.5,
+                    label=f"MuJoCo calibrated, ψ = {frac:.2g}·2π/N")
+        if exact:
+            from clearance.contact_calibration.exact_ln import exact_ln_impact
+
+            ex = exact_ln_impact(clearance, ring, options, mass=result.mass, speed=float(v),
+                                 direction=float(result.directions[-1]))
+            ax.plot(ex.times * 1e6, ex.force, "C3-.", lw=1, label="MuJoCo exact-LN")
+        ax.set_title(f"v = {v:.3g} m/s")
+        ax.set_xlabel("time from contact [µs]")
+        ax.set_xlim(-0.05 * ref.duration * 1e6, 1.15 * ref.duration * 1e6)
+        ax.grid(alpha=0.3)
+    axes[0][0].set_ylabel("normal contact force [N]")
+    axes[0][0].legend(fontsize=7)
+    fig.tight_layout()
+    tmp = path.with_suffix(".tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    os.replace(tmp, path)
+
+
+def calibration_report(
+    result: CalibrationResult, clearance: Clearance, ring: RingGeometry, options: ModelOptions,
+    *, out_dir: str | os.PathLike, stem: str = "calibration", title: str = "Contact calibration",
+    plot_speeds: Sequence[float] | None = None, exact_ln: bool = True, source: str | None = None,
+) -> ReportFiles:
+    """Write the Markdown report and the force–time plot of a calibration.
+
+    Args:
+        result: the calibration (`calibrate` / `fit_contact`).
+        clearance: the joint's clearance.
+        ring: its ring geometry.
+        options: model options it was fitted with.
+        out_dir: output folder (created).
+        stem: file name stem.
+        title: Markdown title.
+        plot_speeds: speeds to plot [m/s]; default the lowest, middle and highest fitted.
+        exact_ln: also plot the exact-LN MuJoCo curve.
+        source: calibration file to cite.
+
+    Returns:
+        Paths of the two files (written atomically).
+    """
+    out = Path(out_dir)
+    sp = np.asarray(result.speeds)
+    speeds = np.asarray(plot_speeds if plot_speeds is not None else [sp[0], sp[len(sp) // 2], sp[-1]])
+    md = out / f"{stem}.md"
+    png = out / f"{stem}.png"
+    _atomic_write(md, _markdown(result, clearance, ring, options, title, source).encode())
+    out.mkdir(parents=True, exist_ok=True)
+    _plot(result, clearance, ring, options, speeds, png, exact_ln)
+    return ReportFiles(md, png)
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="clearance calibrate",
+                                description="Fit the MuJoCo contact of every clearance joint to LN impacts.")
+    p.add_argument("--clearance-mm", type=float, default=0.5, help="radial clearance c [mm] (default 0.5)")
+    p.add_argument("--rpm", type=float, default=5000.0, help="crank speed [rpm] (default 5000)")
+    p.add_argument("--timestep-us", type=float, default=1.0, help="time step [µs] (default 1)")
+    p.add_argument("--segments", type=int, default=None, help="segment count N (default: ripple rule)")
+    p.add_argument("--journal-geom", default="sphere", choices=["sphere", "capsule", "cylinder"])
+    p.add_argument("--segment-geom", default="sphere", choices=["sphere", "capsule", "box", "cylinder"])
+    p.add_argument("--speeds", type=float, nargs=2, metavar=("LO", "HI"), default=None,
+                   help="impact speed range [m/s] (default: impact speed / 50 to impact speed)")
+    p.add_argument("--n-speeds", type=int, default=8, help="fit speeds (default 8)")
+    p.add_argument("--cycle-mass", action="store_true",
+                   help="effective mass: median over the ideal cycle (drive locked) instead of qpos0")
+    p.add_argument("--no-cache", action="store_true", help="refit even if a calibration file exists")
+    p.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
+    return p
+
+
+def main_calibrate(argv: Sequence[str] | None = None) -> int:
+    """``clearance calibrate``: calibrate every clearance joint of the slider-crank scenario.
+
+    Writes ``calibration_<joint>.md`` and ``.png`` in ``--out`` and prints the table.
+
+    Returns:
+        0 on success, 2 on bad input or an unstable calibration.
+    """
+    from clearance.builders import rpm, slider_crank
+    from clearance.contact_calibration.effective_mass import cycle_effective_mass
+    from clearance.contact_calibration.fit import CalibrationStabilityError
+    from clearance.contact_calibration.store import calibrate
+    from clearance.preparation import prepare
+
+    args = _parser().parse_args(argv)
+    try:
+        mech = slider_crank(crank_speed=rpm(args.rpm), radial_clearance=args.clearance_mm * 1e-3)
+        options = ModelOptions(segments=args.segments, timestep=args.timestep_us * 1e-6,
+                               journal_geom=args.journal_geom, segment_geom=args.segment_geom)
+        prep = prepare(mech, options)
+        masses = cycle_effective_mass(prep.model, prep.built, mech) if args.cycle_mass else {}
+        for j in mech.clearance_joints:
+            s, ring = prep.sizing[j.name], prep.built.rings[j.name]
+            em = masses.get(j.name)
+            mass = em.median if em else s.effective_mass
+            speeds = (np.geomspace(args.speeds[0], args.speeds[1], args.n_speeds)
+                      if args.speeds else None)
+            result, path = calibrate(
+                j.clearance, ring, options, mass=mass, impact_speed=s.impact_speed, speeds=speeds,
+                mass_range=em.valid_range if em else None, max_penetration=s.penetration_limit,
+                use_cache=not args.no_cache)
+            files = calibration_report(result, j.clearance, ring, options, out_dir=args.out,
+                                       stem=f"calibration_{j.name}", title=f"Contact calibration: {j.name}",
+                                       source=str(path) if path else None)
+            print(files.markdown.read_text())
+            print(f"wrote {files.markdown} and {files.plot}")
+    except (ValueError, CalibrationStabilityError) as exc:
+        print(f"clearance calibrate: error: {exc}")
+        return 2
+    return 0
