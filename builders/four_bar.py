@@ -1,0 +1,149 @@
+"""Crank-rocker four-bar linkage.
+
+Dimensions are the project's own (the criticality study of REFERENCES.md section 5 gives
+link lengths only in figures we do not have). They were chosen for a Grashof crank-rocker
+(s + l = 0.17 m < p + q = 0.23 m, crank shortest) of bench size (crank 40 mm, as for the
+classic slider-crank's 50 mm) whose transmission angle stays within 44-95 deg over the
+whole revolution, comfortably inside the usual 40-140 deg design range, so that no loop
+comes near a dead point at any speed.
+
+Topology: ground 1, crank 2 (driven, pivot O2), coupler 3, rocker 4 (output, pivot O4).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from clearance.builders._linkage import (
+    DEFAULT_LINEAR_DENSITY,
+    DEFAULT_RADIAL_CLEARANCE,
+    ClearanceFactory,
+    LinkageInfo,
+    bar_link,
+    circle_circle,
+    finish,
+    polar,
+    positive,
+)
+from clearance.builders.slider_crank import rpm
+from clearance.kinematics import TransmissionAngle
+from clearance.model import (
+    STEEL,
+    ContactLaw,
+    Drive,
+    Link,
+    Material,
+    Mechanism,
+    Output,
+    OutputKind,
+)
+
+__all__ = ["four_bar", "FOUR_BAR_INFO"]
+
+FOUR_BAR_INFO = LinkageInfo(
+    topology=(
+        "Grashof crank-rocker: ground 1 (pivots O2, O4), crank 2 (O2-A, driven at constant "
+        "speed), coupler 3 (A-B), rocker 4 (O4-B, output: its angle)."
+    ),
+    driven=("O2",),
+    output_pivot="O4",
+    clearable=("A", "B", "O4"),
+    criticality=("A", "B"),
+    transmission=(TransmissionAngle("B", ("coupler3", "A"), follower=("rocker4", "O4")),),
+    provenance="project's own dimensions (Grashof crank-rocker, transmission angle 44-95 deg)",
+)
+
+
+def four_bar(
+    *,
+    crank_length: float = 0.04,
+    coupler_length: float = 0.13,
+    rocker_length: float = 0.10,
+    ground_length: float = 0.13,
+    linear_density: float = DEFAULT_LINEAR_DENSITY,
+    crank_speed: float = rpm(1000.0),
+    start_angle: float = 0.0,
+    clearance_at: Sequence[str] = ("B",),
+    radial_clearance: float = DEFAULT_RADIAL_CLEARANCE,
+    bearing_radius: float = 0.010,
+    restitution: float = 0.9,
+    friction: float = 0.0,
+    law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH,
+    material: Material = STEEL,
+    gravity: float = 0.0,
+    name: str = "four_bar",
+) -> Mechanism:
+    """Build the crank-rocker four-bar with clearance at the chosen revolute joints.
+
+    The crank pivot O2 is at the origin and the rocker pivot O4 on the +x axis; the coupler
+    assembles above the ground line. Output ``rocker_angle`` is the angle of rocker 4
+    (O4 -> B) from +x [rad].
+
+    Args:
+        crank_length, coupler_length, rocker_length, ground_length: O2-A, A-B, O4-B, O2-O4 [m].
+        linear_density: mass per length of the steel bars [kg/m].
+        crank_speed: constant crank speed [rad/s] (default 1000 rpm).
+        start_angle: crank angle at t = 0 [rad] from +x.
+        clearance_at: joints with clearance, any of ``A``, ``B``, ``O4``; empty for none.
+        radial_clearance: c [m] at every clearance joint.
+        bearing_radius: R_B [m].
+        restitution, friction, law: contact properties of every clearance joint.
+        material: journal and bearing material.
+        gravity: gravitational acceleration [m/s^2] along -y (0 for none).
+        name: mechanism name.
+
+    Returns:
+        The mechanism.
+
+    Raises:
+        ValueError: a value out of range, an unknown clearance joint, or lengths that do
+            not close the loop at the start angle.
+        AssemblyError: the start position is singular.
+    """
+    a = positive("crank_length", crank_length)
+    b = positive("coupler_length", coupler_length)
+    c = positive("rocker_length", rocker_length)
+    d = positive("ground_length", ground_length)
+    lam = positive("linear_density", linear_density, "kg/m")
+    clr = ClearanceFactory(
+        clearance_at, FOUR_BAR_INFO.clearable, radial_clearance=radial_clearance,
+        bearing_radius=bearing_radius, restitution=restitution, friction=friction, law=law,
+        material=material,
+    )
+    o2, o4 = (0.0, 0.0), (d, 0.0)
+    pa = polar(o2, a, start_angle)
+    pb = circle_circle(pa, b, o4, c, left=True, what="coupler 3 / rocker 4")
+    links = (
+        Link("ground", 0.0, 0.0, points={"O2": o2, "O4": o4}),
+        bar_link("crank2", {"O2": o2, "A": pa}, density=lam),
+        bar_link("coupler3", {"A": pa, "B": pb}, density=lam),
+        bar_link("rocker4", {"O4": o4, "B": pb}, density=lam),
+    )
+    joints = (
+        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
+        clr.revolute("A", "crank2", "A", "coupler3", "A"),
+        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
+        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
+    )
+    params = {
+        "crank_length": a,
+        "coupler_length": b,
+        "rocker_length": c,
+        "ground_length": d,
+        "linear_density": lam,
+        "crank_speed": float(crank_speed),
+        "start_angle": float(start_angle),
+        **clr.parameters(),
+        "gravity": float(gravity),
+    }
+    return finish(
+        Mechanism(
+            name=name,
+            links=links,
+            joints=joints,
+            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
+            outputs=(Output("rocker_angle", "rocker4", OutputKind.ANGLE),),
+            gravity=(0.0, -gravity),
+            parameters=params,
+        )
+    )
