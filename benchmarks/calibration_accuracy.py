@@ -1,0 +1,196 @@
+"""Calibrated and exact-LN contact against the LN impact reference; exact-LN cost.
+
+    python benchmarks/calibration_accuracy.py [--out benchmarks/calibration_accuracy.md]
+
+Cases (steel, R_B = 10 mm, LN with cₑ = 0.9, sphere journal / sphere segments, 1 µs,
+implicitfast, impedance 1e-3; segment count by the ripple rule of `prepare`):
+  A. the default slider-crank joint (c = 0.5 mm), effective mass from `prepare` (qpos0),
+     fitted over the default range (impact speed/50 .. impact speed), evaluated at
+     0.1–5 m/s;
+  B. the same joint fitted at the cycle-median effective mass (drive locked);
+  C. the same joint fitted over one decade only (0.3–3 m/s);
+  D. c = 0.1 mm (same mechanism), default range.
+Then exact-LN at 0.1–5 m/s (worst of three directions) and its speed against
+`mujoco.rollout` in sustained contact. Uses a temporary calibration cache (fits are
+always fresh). Writes the Markdown table (and prints it).
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from clearance.builders import slider_crank
+from clearance.contact_calibration import (
+    GOALS,
+    accuracy_rows,
+    accuracy_table,
+    calibrate,
+    clearance_impact,
+    cycle_effective_mass,
+    default_speeds,
+    exact_ln_cost,
+    exact_ln_impact,
+)
+from clearance.options import ModelOptions
+from clearance.preparation import prepare
+
+EVAL_SPEEDS = np.geomspace(0.1, 5.0, 8)  # m/s: the issue's range for the default scenario
+
+
+WHY = """\
+Two parameters (per-row stiffness k and damping b) cannot follow LN over a wide range of
+impact speeds, for two reasons that the tables show separately:
+
+- Restitution (the largest miss, about ±0.03 at the ends of 1.7 decades): N linear rows sum
+  to a Hertz-like spring, but their summed damping grows like sqrt(δ)·δ̇ while LN's grows
+  like δ^1.5·δ̇/δ̇⁻ (MUJOCO_NOTES.md). The damping-to-spring force ratio is then
+  (b·a/(C·k))·δ̇/δ for the ring against χ·δ̇/δ̇⁻ for LN; with δ_max ∝ v^0.8, the ring's
+  loss grows like v^0.2 (1 − e goes from about 0.055 at 0.1 m/s to 0.11 at 5 m/s), so one
+  constant b matches LN's 0.913 at one speed only (about 1 m/s here). A span of 0.055 in e over
+  0.1–5 m/s means ±0.027 at best even for a fit that only balanced restitution; the goal
+  of 0.02 holds over roughly 0.3–3 m/s (one decade, case C).
+- Peak force at high speed (−5.5 % at 5 m/s, c = 0.5 mm; −8 % at 2.5 m/s, c = 0.1 mm): the
+  ring's static force is close to F ∝ δ^1.5/sqrt(c + δ) (the engaged arc is
+  sqrt(2δ/(c + δ))), not K·δ^1.5 with a fixed K, so it softens as δ/c grows: F/δ^1.5 of
+  `ring_force` at c = 0.5 mm, N = 144 falls 8 % from δ = 2 µm to 70 µm, and the
+  δ^1.5/sqrt(c + δ) form accounts for all but 2 % of that. The fit trades it against the +2…5 % at
+  low speed, where only a few segments touch and the force also ripples with direction
+  (worst direction in brackets).
+- Penetration and duration stay well inside their goals everywhere measured.
+
+A third parameter (a penetration-dependent impedance through solimp, kept fixed and
+small in this design) or the exact-LN mode below are the ways past these limits.
+"""
+
+
+def _misses(rows) -> str:
+    """Plain-text list of the goals missed: metric, speeds, largest excess over the goal."""
+    out = []
+    for name, attr, goal, pct in (("peak force", "peak_force_worst", GOALS["peak_force"], True),
+                                  ("max penetration", "max_penetration_worst", GOALS["max_penetration"], True),
+                                  ("duration", "duration_worst", GOALS["duration"], True),
+                                  ("restitution", "restitution_worst", GOALS["restitution"], False)):
+        bad = [(r.speed, getattr(r, attr)) for r in rows if abs(getattr(r, attr)) > goal]
+        if bad:
+            worst = max(bad, key=lambda b: abs(b[1]))
+            val = f"{worst[1] * 100:+.2f} %" if pct else f"{worst[1]:+.4f}"
+            lim = f"{goal:.0%}" if pct else f"{goal}"
+            out.append(f"{name} at {', '.join(f'{v:.3g}' for v, _ in bad)} m/s (worst {val} at "
+                       f"{worst[0]:.3g} m/s against ±{lim})")
+    return "; ".join(out) if out else "none"
+
+
+def _case(title: str, mech, *, speeds=None, cycle: bool = False, eval_speeds=EVAL_SPEEDS) -> tuple[str, dict]:
+    opts = ModelOptions()
+    prep = prepare(mech, opts)
+    j = mech.clearance_joints[0]
+    s, ring = prep.sizing[j.name], prep.built.rings[j.name]
+    mass, mrange = s.effective_mass, None
+    if cycle:
+        em = cycle_effective_mass(prep.model, prep.built, mech)[j.name]
+        mass, mrange = em.median, em.valid_range
+    fit_speeds = speeds if speeds is not None else default_speeds(s.impact_speed)
+    t0 = time.perf_counter()
+    res, _ = calibrate(j.clearance, ring, opts, mass=mass, speeds=fit_speeds, mass_range=mrange,
+                       max_penetration=s.penetration_limit)
+    wall = time.perf_counter() - t0
+    rows = accuracy_rows(j.clearance, ring, opts, res.parameters, mass=mass,
+                         speeds=fit_speeds if eval_speeds is None else eval_speeds)
+    where = (f"{fit_speeds[0]:.3g}–{fit_speeds[-1]:.3g} m/s (the fitted speeds)" if eval_speeds is None
+             else f"{eval_speeds[0]:.3g}–{eval_speeds[-1]:.3g} m/s")
+    p = res.parameters
+    head = (
+        f"### {title}\n\n"
+        f"c = {j.clearance.radial_clearance * 1e3:g} mm, N = {ring.segments}, effective mass "
+        f"{mass:.4g} kg" + (f" (cycle range {mrange[0]:.4g}–{mrange[1]:.4g} kg)" if mrange else " (qpos0)")
+        + f"; fitted over {fit_speeds[0]:.3g}–{fit_speeds[-1]:.3g} m/s ({len(fit_speeds)} speeds × 2 "
+        f"directions) in {wall:.1f} s ({res.nfev} MuJoCo evaluations): per-row k = {p.stiffness:.5g} N/m, "
+        f"b = {p.damping:.5g} N·s/m (nominal {res.initial.stiffness:.5g}, {res.initial.damping:.5g}); "
+        f"ω·h = {res.stability.omega_h:.3f} at {res.stability.penetration * 1e6:.0f} µm.\n\n"
+        f"At the fitted speeds: {sum(r.meets_goals() for r in res.rows)} of {len(res.rows)} meet all "
+        f"goals. At {where}:\n\n"
+    )
+    tail = f"\nGoals missed: {_misses(rows)}.\n"
+    return head + accuracy_table(rows) + tail, {"rows": rows, "ring": ring, "joint": j, "mass": mass,
+                                         "opts": opts, "params": p}
+
+
+def _exact(info: dict) -> str:
+    j, ring, opts, m = info["joint"], info["ring"], info["opts"], info["mass"]
+    lines = ["| v [m/s] | peak F err | δmax err | T err | e − e_LN |", "|---|---|---|---|---|"]
+    worst = np.zeros(4)
+    for v in EVAL_SPEEDS:
+        ref = clearance_impact(j.clearance, mass=m, speed=float(v))
+        errs = []
+        for frac in (0.0, 0.5, 0.3):
+            imp = exact_ln_impact(j.clearance, ring, opts, mass=m, speed=float(v),
+                                  direction=frac * 2 * math.pi / ring.segments)
+            errs.append([imp.peak_force / ref.peak_force - 1, imp.max_penetration / ref.max_penetration - 1,
+                         imp.duration / ref.duration - 1, imp.restitution - ref.restitution])
+        e = np.array(errs)
+        w = e[np.argmax(np.abs(e), axis=0), np.arange(4)]
+        worst = np.maximum(worst, np.abs(w))
+        lines.append(f"| {v:.3g} | {w[0] * 100:+.3f} % | {w[1] * 100:+.3f} % | {w[2] * 100:+.3f} % | {w[3]:+.5f} |")
+    cost = exact_ln_cost(j.clearance, ring, opts, mass=m, params=info["params"],
+                         load=1000.0, nstep=20000)
+    return (
+        "\n".join(lines) + "\n\n"
+        f"Worst over speeds and directions: peak force {worst[0] * 100:.2f} %, penetration "
+        f"{worst[1] * 100:.2f} %, duration {worst[2] * 100:.2f} %, restitution {worst[3]:.5f} "
+        f"(relative {worst[3] / 0.913 * 100:.3f} %).\n\n"
+        f"Cost (one bearing, journal held in contact by 1000 N, N = {ring.segments}, 20 000 steps, "
+        f"one thread): exact-LN Python step loop {cost.exact_steps_per_s:,.0f} steps/s; calibrated "
+        f"mode with `mujoco.rollout` {cost.rollout_steps_per_s:,.0f} steps/s; exact-LN is "
+        f"{cost.ratio:.1f}× slower.\n"
+    )
+
+
+def main(argv: list[str] | None = None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--out", default=str(Path(__file__).with_suffix(".md")))
+    args = ap.parse_args(argv)
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        os.environ["CLEARANCE_CACHE_DIR"] = tmp
+        mech = slider_crank()
+        a, info = _case("A. Default joint, default fit range, qpos0 effective mass", mech)
+        b, _ = _case("B. Default joint, cycle-median effective mass", mech, cycle=True)
+        c, _ = _case("C. Default joint, fitted over one decade (0.3–3 m/s)", mech,
+                     speeds=np.geomspace(0.3, 3.0, 6))
+        d, _ = _case("D. c = 0.1 mm, default fit range", slider_crank(radial_clearance=0.1e-3),
+                     eval_speeds=None)
+        ex = _exact(info)
+    text = (
+        "# Contact calibration accuracy\n\n"
+        f"Command: `python benchmarks/calibration_accuracy.py` ({time.perf_counter() - t0:.0f} s; "
+        f"MuJoCo {mujoco.__version__}, Python {platform.python_version()}, {platform.machine()}, "
+        f"{os.cpu_count()} CPUs).\n\n"
+        "Calibrated mode: MuJoCo's ring of N linear rows with fitted per-row stiffness and damping "
+        "(direct-mode solref, fixed small solimp) against the LN point-mass impact (K of "
+        "REFERENCES.md §1, same effective mass). Goals: peak force and max penetration within 5 %, "
+        "duration within 10 %, restitution within 0.02 of the LN impact's own (0.9132 at cₑ = 0.9). "
+        "Cells: mean over the two impact directions (at a segment, between two), worst direction "
+        "in brackets; bold = outside the goal.\n\n"
+        + a + "\n" + b + "\n" + c + "\n" + d
+        + "\n## Why calibrated mode misses at the ends of the range\n\n" + WHY
+        + "\n## Exact-LN mode (case A's joint and mass)\n\n"
+        "LN imposed on the ring rows each step (Python step loop); worst of three directions "
+        "(at a segment, between two, 0.3 pitch). Goal: 1 % on all four.\n\n" + ex
+    )
+    Path(args.out).write_text(text, encoding="utf-8")
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
