@@ -200,3 +200,44 @@ def test_prepare_calibrated_mode_uses_the_cache(default_mechanism, monkeypatch):
     monkeypatch.setattr("clearance.contact_calibration.store.fit_contact", no_fit)
     p2 = prepare(default_mechanism, opts)
     assert p2.contact == p1.contact
+
+
+def test_cycle_effective_mass(default_prepared):
+    from clearance.contact_calibration import cycle_effective_mass
+    from clearance.mjcf import effective_masses
+
+    p = default_prepared
+    free = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12,
+                                lock_velocity_drives=False)["rod_slider"]
+    locked = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12)["rod_slider"]
+    # Pose 0 is qpos0 and, without the drive lock, the formula is the qpos0 estimate's:
+    # equal to round-off (1e-9 covers the pose mapping's 1e-12 residual).
+    qpos0 = effective_masses(p.model, p.built)["rod_slider"]
+    assert free.values[0] == pytest.approx(qpos0, rel=1e-9)
+    assert free.minimum <= free.median <= free.maximum
+    # Locking the crank removes mobility, so the mass seen can only grow, at every pose
+    # (1e-12: round-off).
+    assert np.all(locked.values >= free.values * (1 - 1e-12))
+    assert locked.valid_range == (locked.minimum, locked.maximum)
+
+
+def test_report_files(fitted, joint, ring, options, tmp_path):
+    from clearance.contact_calibration import calibration_report
+
+    result, path = fitted
+    files = calibration_report(result, joint.clearance, ring, options, out_dir=tmp_path,
+                               exact_ln=False, source=str(path))
+    text = files.markdown.read_text()
+    assert "| v [m/s] |" in text and f"{result.parameters.stiffness:.6g}" in text
+    assert text.count("\n| ") == len(result.rows) + 1  # header + one row per speed
+    assert files.plot.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
+
+
+def test_main_calibrate(tmp_path, capsys):
+    from clearance.contact_calibration import main_calibrate
+
+    assert main_calibrate(["--out", str(tmp_path), "--speeds", "0.3", "3", "--n-speeds", "3"]) == 0
+    assert (tmp_path / "calibration_rod_slider.md").is_file()
+    assert (tmp_path / "calibration_rod_slider.png").is_file()
+    assert "Contact calibration: rod_slider" in capsys.readouterr().out
+    assert main_calibrate(["--out", str(tmp_path), "--timestep-us", "200"]) == 2
