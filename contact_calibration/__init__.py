@@ -79,6 +79,9 @@ _LAZY = {
     "calibrated_parameters": "store",
     # exact LN
     "ExactLNContact": "exact_ln",
+    "impose_exact_ln": "exact_ln",
+    "step_exact_ln": "exact_ln",
+    "ExactLNRun": "exact_ln",
     "ExactLNCost": "exact_ln",
     "exact_ln_impact": "exact_ln",
     "exact_ln_cost": "exact_ln",

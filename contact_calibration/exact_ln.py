@@ -36,7 +36,7 @@ from clearance.mjcf.probe import ring_scene
 from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters, ModelOptions
 
-__all__ = ["ExactLNContact", "exact_ln_impact", "polygon_margin", "ExactLNCost", "exact_ln_cost"]
+__all__ = ["ExactLNContact", "impose_exact_ln", "step_exact_ln", "ExactLNRun", "exact_ln_impact", "polygon_margin", "ExactLNCost", "exact_ln_cost"]
 
 _TINY_SPEED = 1e-9  # m/s: floor of the recorded approach speed (grazing onsets)
 
@@ -104,8 +104,14 @@ class ExactLNContact:
             self.approach = max(rate, _TINY_SPEED)
         return max(self.k * delta**1.5 * (1.0 + self.chi * rate / self.approach), 0.0)
 
-    def apply(self, model: mujoco.MjModel, data: mujoco.MjData) -> float:
-        """Set this joint's rows' reference accelerations; returns the LN force [N]."""
+    def targets(self, model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:
+        """This joint's contact rows and the row forces [N] that carry the LN force.
+
+        Updates the onset state, ``last_force`` [N] and ``last_penetration`` [m].
+
+        Returns:
+            (rows, forces): efc indices and non-negative forces, both shape (m,).
+        """
         e, ed = self._kinematics(model, data)
         r = float(np.hypot(*e))
         u = e / r if r > 0 else np.array([1.0, 0.0])
@@ -116,35 +122,132 @@ class ExactLNContact:
         geom = con.geom
         mine = ((geom[:, 0] == self.jg) | (geom[:, 1] == self.jg)) & (con.efc_address >= 0)
         if not np.any(mine):
-            return f_ln
-        rows_a = con.efc_address[mine]
+            return np.zeros(0, dtype=int), np.zeros(0)
+        rows = con.efc_address[mine]
         sign = np.where(geom[mine, 1] == self.jg, 1.0, -1.0)  # force on the journal per unit row force
         s = (con.frame[mine, :2] * sign[:, None]).T  # (2, m)
-        target = -f_ln * u
-        f, *_ = np.linalg.lstsq(s, target, rcond=1e-10)
+        f, *_ = np.linalg.lstsq(s, -f_ln * u, rcond=1e-10)  # minimum-norm sharing
         f = np.maximum(f, 0.0)
         radial = float(-(s @ f) @ u)
         f = f * (f_ln / radial) if radial > 0 else np.zeros_like(f)
-        self._impose(model, data, rows_a, f)
-        return f_ln
+        return rows, f
 
-    @staticmethod
-    def _impose(model: mujoco.MjModel, data: mujoco.MjData, rows: np.ndarray, f: np.ndarray) -> None:
-        nv = model.nv
-        if mujoco.mj_isSparse(model):
-            jac = np.zeros((data.nefc, nv))
-            mujoco.mju_sparse2dense(jac, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr,
-                                    data.efc_J_colind)
-        else:
-            jac = data.efc_J[: data.nefc * nv].reshape(data.nefc, nv)
-        j = jac[rows]
-        minv_jt = np.zeros((len(rows), nv))
-        mujoco.mj_solveM(model, data, minv_jt, j)
-        a = j @ minv_jt.T
-        mujoco.mj_fwdActuation(model, data)
-        mujoco.mj_fwdAcceleration(model, data)
-        aref = (a + np.diag(data.efc_R[rows])) @ f + j @ data.qacc_smooth
-        data.efc_aref[rows] = aref
+    def apply(self, model: mujoco.MjModel, data: mujoco.MjData) -> float:
+        """Impose this joint alone (see `impose_exact_ln`); returns the LN force [N]."""
+        impose_exact_ln(model, data, [self])
+        return self.last_force
+
+
+def _dense_jacobian(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
+    nv = model.nv
+    if mujoco.mj_isSparse(model):
+        jac = np.zeros((data.nefc, nv))
+        mujoco.mju_sparse2dense(jac, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr,
+                                data.efc_J_colind)
+        return jac
+    return data.efc_J[: data.nefc * nv].reshape(data.nefc, nv)
+
+
+def impose_exact_ln(model: mujoco.MjModel, data: mujoco.MjData,
+                    contacts: list[ExactLNContact]) -> np.ndarray:
+    """Set ``efc_aref`` of every exact-LN joint's rows; call between mj_step1 and mj_step2.
+
+    With c the contact rows (target forces f*) and e the equality rows (always active,
+    their aref left as MuJoCo computed it), the solver's optimality conditions
+    (A + R) f = aref − J a₀ give f_e = (A_ee + R_e)⁻¹(b_e − A_ec f*) and then
+    aref_c = (A_cc + R_c) f* + A_ce f_e + J_c a₀, so the contact rows carry exactly f*
+    and the loop closures react to them as they would to any contact force.
+
+    Args:
+        model: the model.
+        data: its data after `mujoco.mj_step1`.
+        contacts: the joints in exact-LN mode.
+
+    Returns:
+        (len(contacts),) LN force of each joint [N].
+    """
+    parts = [c.targets(model, data) for c in contacts]
+    forces = np.array([c.last_force for c in contacts])
+    rows = np.concatenate([p[0] for p in parts]).astype(int)
+    if not len(rows):
+        return forces
+    fc = np.concatenate([p[1] for p in parts])
+    jac = _dense_jacobian(model, data)
+    eq = np.flatnonzero(data.efc_type[: data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+    allr = np.concatenate([rows, eq])
+    j = jac[allr]
+    minv_jt = np.zeros((len(allr), model.nv))
+    mujoco.mj_solveM(model, data, minv_jt, j)
+    a = j @ minv_jt.T + np.diag(data.efc_R[allr])
+    mujoco.mj_fwdActuation(model, data)
+    mujoco.mj_fwdAcceleration(model, data)
+    ja0 = j @ data.qacc_smooth
+    m = len(rows)
+    aref = a[:m, :m] @ fc + ja0[:m]
+    if len(eq):
+        b_e = data.efc_aref[eq] - ja0[m:]
+        f_e = np.linalg.solve(a[m:, m:], b_e - a[m:, :m] @ fc)
+        aref += a[:m, m:] @ f_e
+    data.efc_aref[rows] = aref
+    return forces
+
+
+@dataclass(frozen=True)
+class ExactLNRun:
+    """States and readings of `step_exact_ln`.
+
+    Attributes:
+        qpos: (nstep, nq) after each step.
+        qvel: (nstep, nv) after each step.
+        sensordata: (nstep, nsensordata) at the start of each step (rollout alignment).
+        force: (nstep, n_joints) LN force imposed during each step [N].
+        penetration: (nstep, n_joints) exact-circle penetration at the start of each step [m].
+    """
+
+    qpos: np.ndarray
+    qvel: np.ndarray
+    sensordata: np.ndarray
+    force: np.ndarray
+    penetration: np.ndarray
+
+
+def step_exact_ln(
+    model: mujoco.MjModel, data: mujoco.MjData, contacts: list[ExactLNContact], nstep: int,
+    *, ctrl: np.ndarray | None = None,
+) -> ExactLNRun:
+    """Step ``nstep`` times with exact-LN contact (the Python counterpart of rollout).
+
+    Args:
+        model: the model (its exact-LN joints' pairs frictionless).
+        data: the data, at the initial state; advanced in place.
+        contacts: the joints in exact-LN mode.
+        nstep: number of steps.
+        ctrl: controls held during the run (default: leave data.ctrl).
+
+    Returns:
+        The run's states, sensors, LN forces and penetrations.
+
+    Raises:
+        RuntimeError: a MuJoCo warning or a non-finite state (the step it happened at).
+    """
+    if ctrl is not None:
+        data.ctrl[:] = ctrl
+    qpos = np.zeros((nstep, model.nq))
+    qvel = np.zeros((nstep, model.nv))
+    sens = np.zeros((nstep, model.nsensordata))
+    force = np.zeros((nstep, len(contacts)))
+    pen = np.zeros((nstep, len(contacts)))
+    warn0 = int(data.warning.number.sum())
+    for i in range(nstep):
+        mujoco.mj_step1(model, data)
+        force[i] = impose_exact_ln(model, data, contacts)
+        pen[i] = [c.last_penetration for c in contacts]
+        mujoco.mj_step2(model, data)
+        qpos[i], qvel[i], sens[i] = data.qpos, data.qvel, data.sensordata
+        if int(data.warning.number.sum()) > warn0 or not np.all(np.isfinite(data.qvel)):
+            raise RuntimeError(f"exact-LN run failed at step {i} (t = {data.time:.6g} s): MuJoCo "
+                               "warning or non-finite state")
+    return ExactLNRun(qpos, qvel, sens, force, pen)
 
 
 @dataclass(frozen=True)
