@@ -224,8 +224,8 @@ def main(argv: list[str] | None = None) -> int:
         + "\n## Exact-LN mode (case A's joint and mass)\n\n"
         "LN imposed on the ring rows each step (Python step loop); worst of three directions "
         "(at a segment, between two, 0.3 pitch). Goal: 1 % on all four.\n\n" + ex
-        + "\nTimings come from a shared machine and varied by up to 2× between runs (exact-LN "
-        "7.5k–17k steps/s in contact); compare the ratios, each taken within one run.\n"
+        + "\nTimings come from a shared machine and varied between runs (exact-LN 7.5k–21k "
+        "steps/s in contact, rollout 100k–216k); compare the ratios, each taken within one run.\n"
     )
     Path(args.out).write_text(text, encoding="utf-8")
     print(text)

@@ -30,6 +30,7 @@ import numpy as np
 from clearance.contact_calibration.fit import (
     FIT_VERSION,
     CalibrationResult,
+    check_stability,
     default_speeds,
     fit_contact,
 )
@@ -201,8 +202,6 @@ def calibrate(
         ValueError: neither speeds nor impact_speed given, or bad arguments.
         CalibrationStabilityError: the parameters are unstable at the time step.
     """
-    from clearance.contact_calibration.fit import check_stability
-
     if speeds is None:
         if impact_speed is None:
             raise ValueError("give impact_speed [m/s] or speeds [m/s]")

@@ -265,3 +265,18 @@ def test_exact_ln_in_the_full_mechanism(default_prepared):
     # force imposed then, up to the solver tolerance (measured 1e-15 relative; 1e-6 N
     # absolute for the steps out of contact).
     np.testing.assert_allclose(sensed, imposed, rtol=1e-6, atol=1e-6)
+
+
+def test_concurrent_writers_leave_a_valid_file(fitted, joint, ring, options):
+    from concurrent.futures import ThreadPoolExecutor
+
+    from clearance.contact_calibration import save_calibration
+
+    result, _ = fitted
+    key = calibration_key(joint.clearance, ring, options, mass=MASS, mass_range=(MASS, MASS),
+                          speeds=np.array([9.0, 10.0]))
+    with ThreadPoolExecutor(8) as pool:
+        paths = list(pool.map(lambda _: save_calibration(key, result), range(32)))
+    assert len(set(paths)) == 1
+    assert load_calibration(key).parameters == result.parameters
+    assert not list(paths[0].parent.glob("*.tmp"))  # no temporary files left behind
