@@ -5,7 +5,7 @@ revolute and prismatic joints and the prescribed drives as constraints with Lagr
 multipliers, held by Baumgarte stabilisation or coordinate projection; clearance joints
 with exact circle-in-circle geometry, any normal law of
 `clearance.contact_calibration.laws` with the approach speed recorded at each contact
-onset, and Ambrosio friction; integration with a scipy `OdeSolver` (DOP853 by default) at
+onset, and Ambrosio friction; integration with a scipy `OdeSolver` (LSODA by default) at
 tight tolerances, every contact onset located on the dense output so no impact is stepped
 over. It returns the same `SimulationResult` as MuJoCo runs.
 

@@ -1,6 +1,6 @@
 """Step a `ReferenceSystem` with a scipy `OdeSolver`, locating every contact onset and end.
 
-The loop drives a scipy `OdeSolver` (DOP853 by default) one step at a time through its
+The loop drives a scipy `OdeSolver` (LSODA by default) one step at a time through its
 public interface (`step`, `dense_output`, `t_old`, `t`, `y`, `step_size`):
 
   * Contact state is a mode per clearance joint: free, or in contact with the approach
@@ -62,6 +62,7 @@ class Trajectory:
         n_rhs: right-hand-side evaluations of the integration.
         n_steps: accepted steps.
         n_restarts: solver restarts (events and projections).
+        n_projections: coordinate projections.
         wall_time_s: wall time of the integration [s].
     """
 
@@ -75,6 +76,7 @@ class Trajectory:
     n_rhs: int = 0
     n_steps: int = 0
     n_restarts: int = 0
+    n_projections: int = 0
     wall_time_s: float = 0.0
 
 
@@ -87,7 +89,7 @@ def integrate_system(
     output_interval: float,
     rtol: float,
     atol: np.ndarray,
-    method: str = "DOP853",
+    method: str = "LSODA",
     projection: tuple[float, float] | None = None,
     track_work: bool = False,
     max_penetration: Sequence[float] | None = None,
@@ -226,13 +228,14 @@ def integrate_system(
                 if max(map(abs, phi)) > projection[0] or np.max(np.abs(vel)) > projection[1]:
                     y = y.copy()
                     y[:nq], y[nq : 2 * nq] = system.project(t, z, zd)
+                    traj.n_projections += 1
                     geo = [gap(system, i, y) for i in range(nc)]
                     h, restart = solver.step_size, True
     return finish()
 
 
 class _Dense:
-    """The current step's dense output, built on first use (DOP853 spends 3 calls on it)."""
+    """The current step's dense output, built on first use (DOP853 spends 3 calls on it, LSODA none)."""
 
     def __init__(self, solver) -> None:
         self.solver, self.sol = solver, None
