@@ -227,6 +227,18 @@ def load_rows(out_dir: str | Path) -> list[dict[str, Any]]:
     return sorted((json.loads(p.read_text()) for p in files), key=lambda r: r["index"])
 
 
+def _describe(obj: Any) -> str:
+    """A description stable across processes (no memory addresses) for the manifest."""
+    import functools
+
+    if isinstance(obj, functools.partial):
+        args = ", ".join([*(repr(a) for a in obj.args), *(f"{k}={v!r}" for k, v in sorted(obj.keywords.items()))])
+        return f"partial({_describe(obj.func)}, {args})"
+    if callable(obj) and hasattr(obj, "__qualname__") and not hasattr(obj, "__dataclass_fields__"):
+        return f"{getattr(obj, '__module__', '?')}.{obj.__qualname__}"
+    return repr(obj)
+
+
 def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str, Any]) -> None:
     path = out / "sweep.json"
     manifest = _json_safe({"points": points, "settings": settings})
@@ -289,7 +301,7 @@ def run_sweep(
     needs_ideal = bool(getattr(evaluation, "ideal", True))
     out = Path(out_dir)
     (out / "points").mkdir(parents=True, exist_ok=True)
-    settings = {"duration": repr(duration), "options": repr(options), "evaluation": repr(evaluation)}
+    settings = {"duration": _describe(duration), "options": repr(options), "evaluation": _describe(evaluation)}
     _check_manifest(out, _json_safe(pts), settings)
     rows = {r["index"]: r for r in load_rows(out) if 0 <= r["index"] < len(pts)}
     todo = [i for i in range(len(pts)) if i not in rows]

@@ -55,8 +55,10 @@ def test_resumed_sweep_equals_uninterrupted(full, tmp_path):
     assert rest.complete and rest.new == 2
     # same thread count (one MuJoCo thread per run): bitwise-equal table
     assert rest.csv_path.read_bytes() == full.csv_path.read_bytes()
-    # a finished sweep run again computes nothing
+    # a finished sweep run again computes nothing; the manifest that guards resumption is
+    # free of memory addresses, so a new process can resume too
     assert _sweep(tmp_path).new == 0
+    assert " at 0x" not in (tmp_path / "sweep.json").read_text()
 
 
 def test_dask_executor_matches_process_pool(full, tmp_path):
