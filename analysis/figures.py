@@ -147,14 +147,27 @@ def plot_poincare(
     names: tuple[str, str],
     classification: PoincareClassification | None = None,
     *,
+    trajectory: np.ndarray | None = None,
     path: str | Path | None = None,
 ) -> plt.Figure:
-    """Poincaré section of two quantities, coloured by section index, with the regime."""
+    """Poincaré section of two quantities, coloured by section index, with the regime.
+
+    Args:
+        points: (K, 2) section points.
+        names: the two quantity names (for labels and units).
+        classification: regime to show in the title.
+        trajectory: (n, 2) full trajectory of the same quantities, drawn in grey behind.
+        path: PNG path to save to.
+    """
     (l1, u1, s1), (l2, u2, s2) = quantity_label(names[0]), quantity_label(names[1])
     fig, ax = plt.subplots(figsize=(6.5, 5.5))
+    if trajectory is not None:
+        ax.plot(trajectory[:, 0] * s1, trajectory[:, 1] * s2, lw=0.3, color="0.7", label="trajectory")
     sc = ax.scatter(points[:, 0] * s1, points[:, 1] * s2, c=np.arange(len(points)), s=12, cmap="viridis",
-                    label="section points")
+                    label="section points", zorder=3)
     fig.colorbar(sc, ax=ax, label="drive period index k")
+    if u1 == u2:
+        ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(f"{l1} [{u1}]")
     ax.set_ylabel(f"{l2} [{u2}]")
     title = "Poincaré section (t = kT)"

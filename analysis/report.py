@@ -140,7 +140,7 @@ def write_report(
         if names[1].endswith("_vel"):
             figures.plot_phase_portrait(phase_portrait(result, names[0]), section=pts, path=out / f"phase_{k}.png")
         else:
-            figures.plot_poincare(pts, names, cl, path=out / f"poincare_{k}.png")
+            figures.plot_poincare(pts, names, cl, trajectory=vals, path=out / f"poincare_{k}.png")
     lines += ["", "Regime criterion: `clearance.analysis.chaos` (distinct points within 1 % of the motion's RMS "
               "size, then nearest-neighbour divergence of the section map). Few periods give few points: the "
               "regime of a short run is indicative only.", ""]
