@@ -18,14 +18,8 @@ import numpy as np
 
 from clearance.contact_calibration.laws import bearing_stiffness
 from clearance.loads import joint_reactions
-from clearance.mjcf import (
-    BuiltModel,
-    add_initial_keyframe,
-    apply_contact,
-    build_spec,
-    choose_segments,
-    effective_masses,
-)
+from clearance.contact_calibration.effective_mass import cycle_effective_mass
+from clearance.mjcf import BuiltModel, add_initial_keyframe, apply_contact, build_spec, choose_segments
 from clearance.model import Mechanism
 from clearance.options import ContactMode, ContactParameters, ModelOptions
 
@@ -46,7 +40,11 @@ class JointSizing:
         typical_penetration: (median_load / K)^(2/3) [m].
         impact_speed: sqrt(2 peak_load c / m_eff), the speed gained crossing the clearance
             under the peak load [m/s].
-        effective_mass: mass seen along the contact normal [kg] (median over directions).
+        effective_mass: mass seen along the contact normal [kg]: median over the ideal
+            cycle of the direction-median (loop closures and velocity drives held), as
+            `clearance.contact_calibration.cycle_effective_mass` measures it.
+        effective_mass_range: (min, max) of that mass over the cycle [kg], the range a
+            calibration is valid for.
         penetration_limit: divergence bound [m]: 4 x the Hertz penetration of an impact at
             ``impact_speed``, at least 4 x that under the peak load.
         segments: ring segment count N.
@@ -60,6 +58,7 @@ class JointSizing:
     effective_mass: float
     penetration_limit: float
     segments: int
+    effective_mass_range: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclass
@@ -126,15 +125,15 @@ def prepare(
         pre[j.name] = (K, fmed, fmax, dtyp)
     built = build_spec(mechanism, options, segs)
     model = built.spec.compile()
-    masses = effective_masses(model, built)
+    masses = cycle_effective_mass(model, built, mechanism) if cjoints else {}
     sizing: dict[str, JointSizing] = {}
     for j in cjoints:
         K, fmed, fmax, dtyp = pre[j.name]
-        m = masses[j.name]
+        m = masses[j.name].median
         v = math.sqrt(2 * max(fmax, 1e-9) * j.clearance.radial_clearance / m)
         d_imp = (5 * m * v**2 / (4 * K)) ** 0.4
         lim = 4 * max(d_imp, (max(fmax, 1e-9) / K) ** (2 / 3))
-        sizing[j.name] = JointSizing(K, fmed, fmax, dtyp, v, m, lim, segs[j.name])
+        sizing[j.name] = JointSizing(K, fmed, fmax, dtyp, v, m, lim, segs[j.name], masses[j.name].valid_range)
     params = dict(contact or {})
     for j in cjoints:
         if j.name not in params:

@@ -16,7 +16,7 @@ import numpy as np
 from mujoco import rollout
 
 from clearance.model import DriveKind, Mechanism
-from clearance.options import ContactParameters, ModelOptions
+from clearance.options import ContactMode, ContactParameters, ModelOptions
 from clearance.preparation import PreparedModel, prepare
 from clearance.readout import read_sensors
 
@@ -114,11 +114,7 @@ def simulate_prepared(
     h = model.opt.timestep
     nstep = int(round(duration / h))
     every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
-    data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, 0)
-    spec_state = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    state = np.empty(mujoco.mj_stateSize(model, spec_state))
-    mujoco.mj_getState(model, data, state, spec_state)
+    step = _exact_ln_stepper(prepared) if prepared.options.contact_mode is ContactMode.EXACT_LN else _rollout_stepper(prepared)
     constant = _constant_controls(mech)
     bar = _progress(progress, nstep)
     parts: list[SimulationResult] = []
@@ -127,11 +123,16 @@ def simulate_prepared(
     while done < nstep:
         n = min(chunk_steps, nstep - done)
         times = (done + np.arange(n)) * h
-        ctrl = _controls(mech, times[:1] if constant else times)[None]
-        states, sens = rollout.rollout(model, data, state[None], ctrl, nstep=n)
-        states, sens = states[0], sens[0]
-        part = read_sensors(prepared, times, sens)
+        ctrl = _controls(mech, times[:1] if constant else times)
+        try:
+            states, sens, data = step(ctrl, n)
+        except _StepFailure as fail:
+            states, sens, data = fail.states, fail.sens, fail.data
+        part = read_sensors(prepared, times[: len(sens)], sens)
         bad = _first_bad(prepared, data, part, states)
+        if bad is None and len(sens) < n:
+            bad = (len(sens), next(iter(part.joints), None), "MuJoCo raised a warning or a non-finite state",
+                   _remedy(prepared))
         if bad is not None:
             idx, joint, why, remedy = bad
             keep = part.sliced(slice(0, idx))
@@ -146,11 +147,75 @@ def simulate_prepared(
                 joint=joint,
             )
         parts.append(part)
-        state = states[-1]
         done += n
         bar(done)
     bar(None)
     return _finish(parts, every, prepared, t0, nstep_done=nstep)
+
+
+class _StepFailure(Exception):
+    """A stepper stopped early; carries what it computed."""
+
+    def __init__(self, states, sens, data):
+        super().__init__("step failure")
+        self.states, self.sens, self.data = states, sens, data
+
+
+def _rollout_stepper(prepared: PreparedModel):
+    """Chunks with `mujoco.rollout` (no Python per step)."""
+    model = prepared.model
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state = np.empty(mujoco.mj_stateSize(model, kind))
+    mujoco.mj_getState(model, data, state, kind)
+    box = {"state": state}
+
+    def step(ctrl: np.ndarray, n: int):
+        states, sens = rollout.rollout(model, data, box["state"][None], ctrl[None], nstep=n)
+        box["state"] = states[0][-1]
+        return states[0], sens[0], data
+
+    return step
+
+
+def _exact_ln_stepper(prepared: PreparedModel):
+    """Chunks with the exact-LN step loop (LN force imposed on the ring rows each step)."""
+    import copy
+
+    from clearance.contact_calibration.exact_ln import ExactLNContact, step_exact_ln
+
+    model = copy.copy(prepared.model)  # ExactLNContact raises pair margins in place
+    for j in prepared.mechanism.clearance_joints:
+        if j.clearance.friction > 0:
+            raise ValueError(
+                f"contact_mode 'exact_ln' supports frictionless joints only (joint '{j.name}' has "
+                f"friction {j.clearance.friction}); use 'calibrated'"
+            )
+    contacts = [
+        ExactLNContact(model, j.clearance, prepared.built.rings[j.name], journal_geom=f"{j.name}__journal",
+                       bearing_site=f"{j.name}__bearing")
+        for j in prepared.mechanism.clearance_joints
+    ]
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+
+    def step(ctrl: np.ndarray, n: int):
+        try:
+            run = step_exact_ln(model, data, contacts, n, ctrl=ctrl if len(ctrl) == n else ctrl[0])
+        except RuntimeError as err:
+            raise _StepFailure(np.zeros((0, 1)), np.zeros((0, model.nsensordata)), data) from err
+        return np.hstack([run.qpos, run.qvel]), run.sensordata, data
+
+    return step
+
+
+def _remedy(prepared: PreparedModel) -> str:
+    h = prepared.options.timestep
+    return (
+        f"use a smaller time step (now {h:g} s, try {h / 2:g} s) or more bearing segments "
+        f"(ModelOptions(segments=...))"
+    )
 
 
 def _finish(parts, every, prepared: PreparedModel, t0: float, *, nstep_done: int):
@@ -191,11 +256,7 @@ def _first_bad(prepared: PreparedModel, data: mujoco.MjData, part, states: np.nd
         over = np.nonzero(~(jr.penetration <= lim))[0]
         if len(over) and over[0] < worst[0]:
             worst = (int(over[0]), name, float(np.nanmax(jr.penetration[over[0]:over[0] + 1])))
-    h = prepared.options.timestep
-    remedy = (
-        f"use a smaller time step (now {h:g} s, try {h / 2:g} s) or more bearing segments "
-        f"(ModelOptions(segments=...))"
-    )
+    remedy = _remedy(prepared)
     if worst[1] is not None and worst[0] <= first_nan:
         lim = prepared.sizing[worst[1]].penetration_limit
         return worst[0], worst[1], (
