@@ -12,9 +12,13 @@ over. It returns the same `SimulationResult` as MuJoCo runs.
 Entry points:
   * `run_reference(mechanism, duration, ...)`: a mechanism from its assembled start.
   * `ReferenceSystem` + `simulate_system(system, q0, qd0, duration, ...)`: any explicit
-    initial state, and systems built `from_parts` (e.g. a free body in a bearing).
+    initial state, and systems built `from_parts` (`journal_in_bearing`: a free body in a
+    ground-fixed bearing, the single-impact check against the calibration's reference).
+
+A `ReferenceSystem` keeps scratch buffers: use one per thread (process pools are fine).
 """
 
+from clearance.reference.examples import journal_in_bearing
 from clearance.reference.integrator import METHODS, IntegrationFailure, Trajectory, integrate_system
 from clearance.reference.run import (
     ReferenceSolverError,
@@ -35,6 +39,7 @@ __all__ = [
     "Stabilisation",
     "Trajectory",
     "integrate_system",
+    "journal_in_bearing",
     "run_reference",
     "simulate_system",
     "to_result",

@@ -172,12 +172,12 @@ def integrate_system(
         while solver.status == "running" and not restart:
             try:
                 with np.errstate(invalid="ignore", over="ignore"):  # rejected trial stages
-                    solver.step()
+                    message = solver.step()
             except SingularConstraintsError as exc:
                 raise fail(str(exc), solver.t, None) from None
             if solver.status == "failed":
-                raise fail(f"the {method} solver failed at t = {solver.t:.9g} s", solver.t,
-                           _deepest(system, geo))
+                raise fail(f"the {method} solver failed at t = {solver.t:.9g} s ({message})",
+                           solver.t, _deepest(system, geo))
             traj.n_steps += 1
             t0s, t1s, y1 = solver.t_old, solver.t, solver.y
             if not np.all(np.isfinite(y1)):

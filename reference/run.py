@@ -18,6 +18,7 @@ import clearance
 from clearance.contact_calibration.laws import STIFFNESS_FORMULA
 from clearance.model import DriveKind, Mechanism
 from clearance.reference.integrator import METHODS, IntegrationFailure, Trajectory, integrate_system
+from clearance.reference.output import assemble_result
 from clearance.reference.system import ReferenceSystem
 from clearance.results import SimulationResult
 
@@ -293,8 +294,6 @@ def to_result(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any
         traj: the raw solution.
         settings: solver settings recorded in the metadata.
     """
-    from clearance.reference.output import assemble_result
-
     meta = _metadata(system, traj, settings)
     return assemble_result(system, traj, meta)
 

@@ -300,7 +300,7 @@ class ReferenceSystem:
                     q[3 * k + 2] += r[10]
         qa = np.array(q)
         if self.n_constraints == 0:
-            return Evaluation(self.minv * qa, np.zeros(0), [], cres, self._torques(None, zdl))
+            return Evaluation(self.minv * qa, np.zeros(0), [], cres, self._torques(None))
         phi, gam, phit = self.rows.evaluate(t, zl, zdl)
         g = self.rows.G
         gs = np.array(gam)
@@ -310,9 +310,9 @@ class ReferenceSystem:
         gm = g * self.minv
         lam = _spd_solve(gm @ g.T, gm @ qa - gs, t)
         zdd = self.minv * (qa - g.T @ lam)
-        return Evaluation(zdd, lam, phi, cres, self._torques(lam, zdl))
+        return Evaluation(zdd, lam, phi, cres, self._torques(lam))
 
-    def _torques(self, lam: np.ndarray | None, zdl: Sequence[float]) -> list[float]:
+    def _torques(self, lam: np.ndarray | None) -> list[float]:
         out = []
         for d, row in zip(self.drives, self._drive_row):
             out.append(d.torque if row < 0 else -float(lam[row]))

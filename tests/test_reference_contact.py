@@ -61,6 +61,7 @@ def test_circle_in_circle_geometry_by_hand() -> None:
     # moments about the centres of mass: journal R_J F_T; bearing (ground here) -R_B F_T
     expected = (ex, ey, vx, vy, delta, ddot, vt, fx, fy, cl.journal_radius * ft,
                 -cl.bearing_radius * ft, fn, ft)
+    # abs 1e-18: lets exact zeros compare with rounding-level values (quantities >= 1e-6)
     assert r == pytest.approx(expected, rel=ULPS, abs=1e-18)
     # free mode (approach speed 0): geometry but no force
     assert evaluate_contact(cj, [ex, ey, 0.7], [vx, vy, w], 0.0)[7:] == (0.0,) * 6
@@ -83,7 +84,7 @@ def test_result_frames_follow_the_conventions(crank_rod_run) -> None:
     ew = rod[:, :2] - pin  # journal centre: rod frame origin
     e = np.stack([c * ew[:, 0] + s * ew[:, 1], -s * ew[:, 0] + c * ew[:, 1]], axis=1)
     assert np.allclose(jr.eccentricity, e, rtol=0, atol=1e-15)  # same arithmetic, rounding
-    assert np.allclose(jr.penetration, np.hypot(e[:, 0], e[:, 1]) - 0.5e-3, rtol=0, atol=1e-15)
+    assert np.allclose(jr.penetration, np.hypot(e[:, 0], e[:, 1]) - 0.5e-3, rtol=0, atol=1e-15)  # idem
     # rate = time derivative of the frame-expressed vector; central differences at 1 us are
     # accurate to ~h^2 e''' / 6 ~ 1e-3 of max|rate| through the impacts (measured 4e-4)
     fd = np.gradient(jr.eccentricity, res.times, axis=0)

@@ -65,7 +65,8 @@ def four_bar(clearance: bool = False, *, speed: float = rpm(1500), restitution: 
     joints = (
         Joint("O2", JointType.REVOLUTE, "ground", "o2", "crank", "o"),
         Joint("A", JointType.REVOLUTE, "crank", "a", "coupler", "a"),
-        Joint("B", JointType.REVOLUTE, "coupler", "b", "rocker", "b", clearance=_clearance(clearance, restitution)),
+        Joint("B", JointType.REVOLUTE, "coupler", "b", "rocker", "b",
+              clearance=_clearance(clearance, restitution)),
         Joint("O4", JointType.REVOLUTE, "ground", "o4", "rocker", "o"),
     )
     drives = (Drive("crank", "O2", DriveKind.CONSTANT_SPEED, speed=speed),)
@@ -93,7 +94,8 @@ def five_bar(clearance: bool = False, *, restitution: float = 0.9) -> Mechanism:
         Joint("O2", JointType.REVOLUTE, "ground", "o2", "crank2", "o"),
         Joint("A1", JointType.REVOLUTE, "crank1", "a", "coupler1", "a"),
         Joint("A2", JointType.REVOLUTE, "crank2", "a", "coupler2", "a"),
-        Joint("P", JointType.REVOLUTE, "coupler1", "p", "coupler2", "p", clearance=_clearance(clearance, restitution)),
+        Joint("P", JointType.REVOLUTE, "coupler1", "p", "coupler2", "p",
+              clearance=_clearance(clearance, restitution)),
     )
     w = rpm(1000)
     drives = (
@@ -176,7 +178,7 @@ def test_constraint_rows_match_kinematics_constraint_system(mech: Mechanism) -> 
         phi, gam, phit = system.rows.evaluate(t, z.tolist(), zd.tolist())
         # the same residuals in either coordinates (rounding only)
         assert np.allclose(phi, cs.phi(q, t), rtol=0, atol=1e-15)
-        assert np.allclose(phit, cs.phi_t(t), rtol=0, atol=1e-12)
+        assert np.allclose(phit, cs.phi_t(t), rtol=0, atol=1e-12)  # rates ~100 rad/s, rounding
         g = system.rows.G.copy()
         # G against central differences of phi (step 1e-6: truncation ~1e-12, rounding ~1e-10)
         h = 1e-6
