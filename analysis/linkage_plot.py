@@ -154,37 +154,50 @@ def plot_linkage(
         clear = j.clearance is not None
         ax.add_patch(plt.Circle(tuple(p), r_joint * (1.35 if clear else 1.0), facecolor="white",
                                 edgecolor="#d62728" if clear else "k", lw=2.0 if clear else 1.2, zorder=5))
-    # labels, placed greedily
+    # labels, placed greedily as boxes (size estimated from the font size and the data scale)
+    fig_w, fig_h = ax.figure.get_size_inches()
+    pos = ax.get_position()
+    width, height = np.ptp(all_pts, axis=0) + 0.25 * span
+    scale = max(width / (fig_w * pos.width), height / (fig_h * pos.height))  # data units per inch
+    boxes: list[tuple[np.ndarray, float, float]] = []
     placed: list[np.ndarray] = []
-    obstacles = list(jpos.values())
-    rad = 0.06 * span
+    samples = [a + f * (b - a) for a, b in segments for f in np.linspace(0.0, 1.0, 12)]
+    samples = np.array(samples) if samples else np.zeros((0, 2))
+    joints_xy = np.array(list(jpos.values())) if jpos else np.zeros((0, 2))
 
-    def place(anchor: np.ndarray, text: str, **kw: Any) -> None:
+    def place(anchor: np.ndarray, text: str, size: float, **kw: Any) -> None:
+        hw = 0.5 * len(text) * 0.62 * size / 72 * scale + 0.004 * span
+        hh = 0.62 * size / 72 * scale + 0.004 * span
         best, best_cost = anchor, math.inf
-        for k in range(16):
-            cand = anchor + rad * np.array([math.cos(k * math.pi / 8 + 0.2), math.sin(k * math.pi / 8 + 0.2)])
-            cost = 0.0
-            for o in obstacles + placed:
-                cost += max(0.0, 1.5 * rad - float(np.linalg.norm(cand - o))) ** 2 * 4
-            for a, b in segments:
-                cost += max(0.0, 0.7 * rad - _seg_dist(cand, a, b)) ** 2
-            if cost < best_cost:
-                best, best_cost = cand, cost
-        placed.append(best)
+        for r in (0.035 * span, 0.07 * span, 0.11 * span):
+            for k in range(16):
+                d = np.array([math.cos(k * math.pi / 8 + 0.1), math.sin(k * math.pi / 8 + 0.1)])
+                c = anchor + d * r + np.array([d[0] * hw, d[1] * hh])
+                inside = lambda p, m=0.0: (np.abs(p[:, 0] - c[0]) < hw + m) & (np.abs(p[:, 1] - c[1]) < hh + m)  # noqa: E731
+                cost = 0.3 * r / span
+                cost += 3.0 * np.count_nonzero(inside(joints_xy, r_joint)) + 1.0 * np.count_nonzero(inside(samples))
+                for bc, bw, bh in boxes:
+                    ox = max(0.0, min(c[0] + hw, bc[0] + bw) - max(c[0] - hw, bc[0] - bw))
+                    oy = max(0.0, min(c[1] + hh, bc[1] + bh) - max(c[1] - hh, bc[1] - bh))
+                    cost += 20.0 * ox * oy / (hw * hh)
+                if cost < best_cost:
+                    best, best_cost = c, cost
+        boxes.append((best, hw, hh))
+        placed.extend([best + [hw, hh], best - [hw, hh]])
         ax.annotate(text, xy=tuple(anchor), xytext=tuple(best), ha="center", va="center", zorder=6,
-                    arrowprops=dict(arrowstyle="-", color="0.5", lw=0.6, shrinkA=0, shrinkB=3), **kw)
+                    fontsize=size, arrowprops=dict(arrowstyle="-", color="0.5", lw=0.6, shrinkA=0, shrinkB=3), **kw)
 
     if joint_names:
         for j in mechanism.joints:
             anchor = jpos.get(j.name, world[j.link_b][j.point_b])
             label = j.name + (" (c)" if j.clearance is not None else "")
-            place(anchor, label, fontsize=9, fontweight="bold",
+            place(anchor, label, 9.0, fontweight="bold",
                   color="#d62728" if j.clearance is not None else "k",
                   bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
     if link_names:
         for lk in mechanism.moving_links:
             pts = np.array(list(world[lk.name].values()))
-            place(pts.mean(axis=0), lk.name, fontsize=8.5, style="italic", color=colour[lk.name])
+            place(pts.mean(axis=0), lk.name, 8.5, style="italic", color=colour[lk.name])
     ax.set_aspect("equal")
     ext = np.vstack([all_pts, *placed]) if placed else all_pts
     m = 0.06 * span
