@@ -91,7 +91,13 @@ class ClearanceAtJoint:
 
 
 def criticality_points(joints: Sequence[str], clearances: Sequence[float], speeds: Sequence[float]) -> list[dict[str, Any]]:
-    """Grid points ``{"joint", "clearance" [m], "speed" [rad/s]}``: joint-major order."""
+    """Grid points ``{"joint", "clearance" [m], "speed" [rad/s]}`` in joint-major order.
+
+    Args:
+        joints: joint names.
+        clearances: radial clearances [m].
+        speeds: drive speeds [rad/s].
+    """
     return [{"joint": j, "clearance": float(c), "speed": float(s)} for j in joints for c in clearances for s in speeds]
 
 

@@ -72,7 +72,15 @@ def plot_deviation(
     *,
     path: str | Path | None = None,
 ) -> plt.Figure:
-    """Deviation from ideal over the statistics window, its 90 % band, and distributions."""
+    """Deviation from ideal over the statistics window, its 90 % band, and distributions.
+
+    Args:
+        result: run with clearance.
+        ideal: run of the ideal twin.
+        output: output name.
+        stats: its `DeviationStatistics` (the window is taken from them).
+        path: PNG path to save to.
+    """
     t, y, y0 = deviation_series(result, ideal, output, skip=stats.window_start - result.times[0])
     label, unit, scale = quantity_label(output)
     fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [2, 1]})
@@ -99,7 +107,13 @@ def plot_deviation(
 
 
 def plot_contact_modes(result: SimulationResult, modes: list[JointContactModes], *, path: str | Path | None = None) -> plt.Figure:
-    """Contact-force magnitude per joint with each contact event shaded by its mode."""
+    """Contact-force magnitude per joint with each contact event shaded by its mode.
+
+    Args:
+        result: the run.
+        modes: `JointContactModes` of the joints to show (one panel each).
+        path: PNG path to save to.
+    """
     fig, axes = plt.subplots(len(modes), 1, figsize=(9, 2.8 * len(modes)), sharex=True, squeeze=False)
     for ax, m in zip(axes[:, 0], modes):
         jr = result.joints[m.joint]
@@ -124,7 +138,13 @@ def plot_contact_modes(result: SimulationResult, modes: list[JointContactModes],
 def plot_phase_portrait(
     portrait: PhasePortrait, *, section: np.ndarray | None = None, path: str | Path | None = None
 ) -> plt.Figure:
-    """Phase portrait (quantity against its rate), with Poincaré points on top if given."""
+    """Phase portrait (quantity against its rate), with Poincaré points on top if given.
+
+    Args:
+        portrait: `PhasePortrait` data.
+        section: (K, 2) Poincaré points (quantity, rate) to mark.
+        path: PNG path to save to.
+    """
     label, unit, scale = quantity_label(portrait.name)
     vlab, vunit, vscale = quantity_label(f"{portrait.name}_vel" if "." not in portrait.name
                                          else portrait.name.replace(".e", ".v"))

@@ -257,7 +257,18 @@ def compare_response(
     method: LagMethod = LagMethod.CROSS_CORRELATION,
     skip: float | None = None,
 ) -> ResponseComparison:
-    """Lag and peaks of ``output`` against the ideal run (see `output_lag`, `output_peaks`)."""
+    """Lag and peaks of ``output`` against the ideal run (see `output_lag`, `output_peaks`).
+
+    Args:
+        result: run with clearance.
+        ideal: run of the ideal twin.
+        output: output name.
+        method: `LagMethod` of the lag.
+        skip: start-up transient skipped by the lag [s]; default one drive period.
+
+    Raises:
+        KeyError: unknown output.
+    """
     period = drive_period(result)
     lag = output_lag(result, ideal, output, method=method, skip=skip)
     pk, pk0 = output_peaks(result, output, period=period), output_peaks(ideal, output, period=period)

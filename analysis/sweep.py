@@ -175,6 +175,18 @@ def evaluate_point(
 
     A point whose model cannot be built or whose run diverges gives a row with status
     ``error`` and the message, so one bad point does not stop the sweep.
+
+    Args:
+        index: point index.
+        point: point parameters.
+        make_mechanism: point -> Mechanism.
+        duration: simulated time [s], a callable mechanism -> duration, or None (3 periods).
+        options: `ModelOptions` (None: defaults).
+        evaluation: (result, ideal or None, mechanism) -> row fields.
+        needs_ideal: also simulate the ideal twin.
+
+    Returns:
+        The row (JSON-compatible dict) with ``timing`` added.
     """
     from clearance.simulation import default_duration, simulate
 
@@ -315,7 +327,11 @@ def run_sweep(
         executor = client.get_executor()
     elif executor is None:
         executor = ProcessPoolExecutor(max_workers=max_workers, mp_context=multiprocessing.get_context("spawn"))
-    window = 2 * (max_workers or os.cpu_count() or 1)
+    # points in flight: twice the workers, so workers never wait and a stop wastes little
+    slots = max_workers or getattr(executor, "_max_workers", None) or os.cpu_count() or 1
+    if client is not None:
+        slots = max(1, sum(client.nthreads().values()))
+    window = 2 * slots
     bar = _bar(progress, len(pts), len(rows))
     in_flight: dict[Any, int] = {}
     queue = iter(todo)
