@@ -16,7 +16,7 @@ this criterion (`classify_poincare`):
    strange attractor nearby points separate, and the median is of the order of the largest
    Lyapunov exponent times T. A median above ``divergence_threshold`` means CHAOTIC,
    otherwise QUASI_PERIODIC.
-3. Fewer than ``min_points`` non-periodic points give UNDETERMINED.
+3. Fewer than ``min_points`` non-periodic points, or a single point, give UNDETERMINED.
 
 The Grassberger-Procaccia correlation dimension is reported beside the regime (about 1
 for a closed curve, above 1 for the section of a strange attractor) as a diagnostic.
@@ -313,6 +313,8 @@ def classify_poincare(
     p = p.reshape(len(p), -1)
     if len(p) == 0 or not np.isfinite(p).all():
         raise ValueError("points must be a non-empty array of finite values")
+    if len(p) < 2:  # one point says nothing about recurrence
+        return PoincareClassification(Regime.UNDETERMINED, len(p), 1, 0, float("nan"), float("nan"))
     rms = float(np.sqrt(np.mean(np.sum((p - p.mean(axis=0)) ** 2, axis=1))))
     if rms <= atol:
         return PoincareClassification(Regime.PERIODIC, len(p), 1, 1, float("nan"), float("nan"))

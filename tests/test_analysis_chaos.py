@@ -110,6 +110,14 @@ def test_correlation_dimension_of_a_circle_and_a_square():
     assert abs(map_divergence(np.column_stack([np.cos(k), np.sin(k)]))) < 1e-9
 
 
+def test_classify_small_sets():
+    # one point: no recurrence seen; two equal points: period 1; 2 distinct points: each
+    # group must be seen twice before a period is claimed
+    assert classify_poincare(np.array([[1.0, 2.0]])).regime is Regime.UNDETERMINED
+    assert classify_poincare(np.array([[1.0], [1.0]])).period == 1
+    assert classify_poincare(np.array([[1.0], [2.0]])).regime is Regime.UNDETERMINED
+
+
 def test_classify_rejects_bad_input():
     with pytest.raises(ValueError, match="finite"):
         classify_poincare(np.array([[np.nan, 1.0]]))
