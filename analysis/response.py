@@ -266,11 +266,16 @@ def compare_response(
         method: `LagMethod` of the lag.
         skip: start-up transient skipped by the lag [s]; default one drive period.
 
+    The lag is NaN when the run is too short to search for it.
+
     Raises:
         KeyError: unknown output.
     """
     period = drive_period(result)
-    lag = output_lag(result, ideal, output, method=method, skip=skip)
+    try:
+        lag = output_lag(result, ideal, output, method=method, skip=skip)
+    except ValueError:
+        lag = float("nan")  # run too short for a lag search: peaks are still meaningful
     pk, pk0 = output_peaks(result, output, period=period), output_peaks(ideal, output, period=period)
     big0 = max(abs(pk0.max_value), abs(pk0.min_value))
     big = max(abs(pk.max_value), abs(pk.min_value))

@@ -3,6 +3,9 @@
     clearance run        simulate a scenario and write arrays, summary, figures, MJCF
     clearance reference  run a scenario with the exact-geometry reference solver
     clearance mjcf       write the MuJoCo model of a scenario
+    clearance calibrate  fit contact parameters to LN impacts and write a report
+    clearance sweep      bifurcation diagram over clearance or drive speed (resumable)
+    clearance rank       joint criticality ranking (resumable)
 
 Units on the command line are the ones people use (mm, rpm, µs); they are converted to SI
 here, once.
@@ -75,10 +78,21 @@ def _options(args):
     )
 
 
+_FORWARDED = {
+    "calibrate": ("clearance.contact_calibration.report", "main_calibrate",
+                  "fit contact parameters to LN impacts; table and force-time plot"),
+    "sweep": ("clearance.analysis.cli_commands", "main_sweep",
+              "bifurcation diagram over clearance or drive speed (resumable sweep)"),
+    "rank": ("clearance.analysis.cli_commands", "main_rank", "joint criticality ranking (resumable sweep)"),
+}
+
+
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the `clearance` command."""
     p = argparse.ArgumentParser(prog="clearance", description=__doc__.split("\n\n")[0])
     sub = p.add_subparsers(dest="command", required=True)
+    for name, (_, _, text) in _FORWARDED.items():
+        sub.add_parser(name, help=f"{text} (see 'clearance {name} --help')", add_help=False)
     r = sub.add_parser("run", help="simulate a scenario and write results, figures and the model")
     _add_scenario_args(r)
     r.add_argument("--revolutions", type=_positive(float, "--revolutions"), default=3.0,
@@ -122,8 +136,8 @@ def _cmd_mjcf(args) -> int:
 
 
 def _write_outputs(args, mech, result, ideal, out: Path) -> None:
-    """Arrays, summary CSV, figures (and a rerun recording) of a run and its ideal twin."""
-    from clearance.analysis.plots import plot_contact_force, plot_orbit, plot_response
+    """Arrays, summary CSV, the Markdown report with its figures (and a rerun recording)."""
+    from clearance.analysis.report import write_report
     from clearance.analysis.summary import summarise, write_summary_csv
 
     result.save(out / "result")
@@ -134,13 +148,12 @@ def _write_outputs(args, mech, result, ideal, out: Path) -> None:
         print(f"  wrote {record(result, mech, args.rerun, ideal=ideal)}")
     rows = summarise(result, ideal)
     write_summary_csv(rows, out / "summary.csv")
+    period = min(d.period for d in mech.drives if d.kind.value != "torque")
+    # statistics skip the first drive period as start-up transient when the run is long enough
+    skip = period if result.times[-1] > 2 * period else 0.0
+    write_report(out, result, ideal, skip=skip)
     output = mech.outputs[0].name
     angular = mech.outputs[0].kind.value == "angle"
-    plot_response(result, ideal, output, angular=angular, path=out / f"{output}_response_vs_ideal.png")
-    if result.joints:
-        plot_contact_force(result, path=out / "contact_force.png")
-    for j in mech.clearance_joints:
-        plot_orbit(result, j.name, j.clearance.radial_clearance, path=out / f"journal_orbit_{j.name}.png")
     for r in rows:
         print(f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
               f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
@@ -219,8 +232,14 @@ def _cmd_reference(args) -> int:
 
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the `clearance` console script."""
+    import importlib
+
     from clearance.kinematics import AssemblyError
 
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] in _FORWARDED:
+        module, func, _ = _FORWARDED[argv[0]]
+        return getattr(importlib.import_module(module), func)(argv[1:])
     args = build_parser().parse_args(argv)
     try:
         if args.command == "run":

@@ -16,7 +16,7 @@ def test_run_writes_everything(tmp_path):
     rc = main(["run", "--duration-ms", "2", "--out", str(out), "--no-progress"])
     assert rc == 0
     for name in ("result.npz", "result.json", "ideal.npz", "summary.csv", "model.xml", "ideal_model.xml",
-                 "slider_x_response_vs_ideal.png", "contact_force.png", "journal_orbit_rod_slider.png"):
+                 "report.md", "response_vs_ideal.png", "deviation.png", "contact_force.png", "orbit_rod_slider.png"):
         assert (out / name).stat().st_size > 0, name
     rows = list(csv.DictReader((out / "summary.csv").open()))
     assert rows[0]["joint"] == "rod_slider" and float(rows[0]["peak_force"]) > 0
@@ -50,4 +50,4 @@ def test_reference_command(tmp_path):
     assert main(["reference", "--duration-ms", "0.4", "--out", str(out), "--no-progress"]) == 0
     rows = list(csv.DictReader((out / "summary.csv").open()))
     assert float(rows[0]["peak_force"]) > 1e3  # REFERENCES.md section 3: forces of order 1e4 N
-    assert (out / "journal_orbit_rod_slider.png").stat().st_size > 0
+    assert (out / "orbit_rod_slider.png").stat().st_size > 0
