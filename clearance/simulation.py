@@ -9,7 +9,7 @@ result computed up to the last good step.
 from __future__ import annotations
 
 import time as _time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 
 import mujoco
 import numpy as np
@@ -60,6 +60,7 @@ def simulate(
     contact: dict[str, ContactParameters] | None = None,
     progress: bool | Callable[[float], None] = False,
     chunk_steps: int = 100_000,
+    initial_eccentricity: Mapping[str, tuple[float, float]] | None = None,
 ):
     """Simulate a mechanism with clearance joints in MuJoCo.
 
@@ -73,6 +74,9 @@ def simulate(
         progress: True for a progress bar on stderr, or a callable receiving the fraction
             done (0..1) after each chunk.
         chunk_steps: steps per `mujoco.rollout` call (memory bound).
+        initial_eccentricity: clearance joint name -> (e_x, e_y) [m] journal centre in the
+            bearing frame at t = 0 (default: centred). The other coordinates change as
+            little as the loop closures and drive angles allow; velocities stay ideal.
 
     Returns:
         SimulationResult (times, outputs, per-joint eccentricity / penetration / force,
@@ -93,9 +97,17 @@ def simulate(
         raise ValueError(f"output_interval must be > 0 s (got {output_interval!r})")
     if not isinstance(chunk_steps, int) or chunk_steps < 1:
         raise ValueError(f"chunk_steps must be a positive integer (got {chunk_steps!r})")
+    if initial_eccentricity is not None:
+        names = {j.name for j in mechanism.clearance_joints}
+        for k, v in dict(initial_eccentricity).items():
+            if k not in names:
+                raise ValueError(f"initial_eccentricity: '{k}' is not a clearance joint (clearance joints: {sorted(names)})")
+            if not (len(v) == 2 and all(np.isfinite(x) for x in v)):
+                raise ValueError(f"initial_eccentricity['{k}'] must be (e_x, e_y) in metres (got {v!r})")
     prepared = prepare(mechanism, options, contact=contact)
     return simulate_prepared(
-        prepared, duration=duration, output_interval=output_interval, progress=progress, chunk_steps=chunk_steps
+        prepared, duration=duration, output_interval=output_interval, progress=progress, chunk_steps=chunk_steps,
+        initial_eccentricity=initial_eccentricity,
     )
 
 
@@ -106,6 +118,7 @@ def simulate_prepared(
     output_interval: float | None = None,
     progress: bool | Callable[[float], None] = False,
     chunk_steps: int = 100_000,
+    initial_eccentricity: Mapping[str, tuple[float, float]] | None = None,
 ):
     """Run an already prepared model (see `simulate` for the arguments)."""
     from clearance.results import SimulationResult
@@ -114,7 +127,9 @@ def simulate_prepared(
     h = model.opt.timestep
     nstep = int(round(duration / h))
     every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
-    step = _exact_ln_stepper(prepared) if prepared.options.contact_mode is ContactMode.EXACT_LN else _rollout_stepper(prepared)
+    qpos0 = _initial_qpos(prepared, initial_eccentricity)
+    exact = prepared.options.contact_mode is ContactMode.EXACT_LN
+    step = _exact_ln_stepper(prepared, qpos0) if exact else _rollout_stepper(prepared, qpos0)
     constant = _constant_controls(mech)
     bar = _progress(progress, nstep)
     parts: list[SimulationResult] = []
@@ -161,11 +176,40 @@ class _StepFailure(Exception):
         self.states, self.sens, self.data = states, sens, data
 
 
-def _rollout_stepper(prepared: PreparedModel):
-    """Chunks with `mujoco.rollout` (no Python per step)."""
-    model = prepared.model
+def _initial_qpos(prepared: PreparedModel, targets) -> np.ndarray | None:
+    """qpos with journals moved to ``targets`` (None: the keyframe's)."""
+    if not targets:
+        return None
+    from clearance.initial_state import offset_journals
+
+    model, mech = prepared.model, prepared.mechanism
+    for k, v in targets.items():
+        c = mech.joint(k).clearance.radial_clearance
+        lim = prepared.sizing[k].penetration_limit
+        if np.hypot(*v) > c + lim:
+            raise ValueError(
+                f"initial_eccentricity['{k}'] = {tuple(v)} m puts the journal {np.hypot(*v) - c:.3g} m into its "
+                f"bearing, beyond the divergence bound {lim:.3g} m; expected |e| <= c + bound = {c + lim:.4g} m"
+            )
+    return offset_journals(
+        model, model.key_qpos[0], targets,
+        bearings={k: mech.joint(k).clearance.radial_clearance for k in targets},
+        fixed_joints=[d.joint for d in mech.drives],
+    )
+
+
+def _start(model: mujoco.MjModel, qpos0: np.ndarray | None) -> mujoco.MjData:
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
+    if qpos0 is not None:
+        data.qpos[:] = qpos0
+    return data
+
+
+def _rollout_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
+    """Chunks with `mujoco.rollout` (no Python per step)."""
+    model = prepared.model
+    data = _start(model, qpos0)
     kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.empty(mujoco.mj_stateSize(model, kind))
     mujoco.mj_getState(model, data, state, kind)
@@ -179,7 +223,7 @@ def _rollout_stepper(prepared: PreparedModel):
     return step
 
 
-def _exact_ln_stepper(prepared: PreparedModel):
+def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
     """Chunks with the exact-LN step loop (LN force imposed on the ring rows each step)."""
     import copy
 
@@ -197,8 +241,7 @@ def _exact_ln_stepper(prepared: PreparedModel):
                        bearing_site=f"{j.name}__bearing")
         for j in prepared.mechanism.clearance_joints
     ]
-    data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, 0)
+    data = _start(model, qpos0)
 
     def step(ctrl: np.ndarray, n: int):
         try:
