@@ -37,14 +37,21 @@ def _positive(kind: type, name: str):
 
 def _add_scenario_args(p: argparse.ArgumentParser) -> None:
     g = p.add_argument_group("scenario")
-    g.add_argument("--mechanism", default="slider_crank", choices=["slider_crank"],
-                   help="mechanism from the catalogue (default: slider_crank)")
-    g.add_argument("--clearance-mm", type=_positive(float, "--clearance-mm"), default=0.5,
-                   help="radial clearance c [mm] (default 0.5)")
+    from clearance.builders import CATALOGUE
+
+    g.add_argument("--mechanism", default="slider_crank", choices=sorted(CATALOGUE), metavar="NAME",
+                   help="mechanism from the catalogue (default: slider_crank; one of: "
+                        + ", ".join(sorted(CATALOGUE)) + ")")
+    g.add_argument("--scenario", default=None, metavar="TOML",
+                   help="scenario file (a catalogue builder with overrides, or a whole mechanism); "
+                        "replaces --mechanism and the options below")
+    g.add_argument("--clearance-mm", type=_positive(float, "--clearance-mm"), default=None,
+                   help="radial clearance c [mm] (default: the builder's; 0.5 for the slider-crank)")
     g.add_argument("--clearance-at", nargs="*", default=None, metavar="JOINT",
-                   help="joints with clearance (default: rod_slider for the slider-crank); "
+                   help="joints with clearance (default: the builder's, rod_slider for the slider-crank); "
                         "give none for the ideal mechanism")
-    g.add_argument("--rpm", type=_positive(float, "--rpm"), default=5000.0, help="crank speed [rpm] (default 5000)")
+    g.add_argument("--rpm", type=_positive(float, "--rpm"), default=None,
+                   help="crank speed [rpm] (default: the builder's; 5000 for the slider-crank)")
     g.add_argument("--gravity", action="store_true", help="gravity 9.81 m/s² along -y")
     g = p.add_argument_group("numerics")
     g.add_argument("--timestep-us", type=_positive(float, "--timestep-us"), default=1.0,
@@ -56,15 +63,33 @@ def _add_scenario_args(p: argparse.ArgumentParser) -> None:
 
 
 def _mechanism(args):
-    from clearance.builders import rpm, slider_crank
+    """The scenario's mechanism: a scenario file, or a catalogue builder with the options given."""
+    import inspect
 
-    at = ("rod_slider",) if args.clearance_at is None else tuple(args.clearance_at)
-    return slider_crank(
-        crank_speed=rpm(args.rpm),
-        radial_clearance=args.clearance_mm * 1e-3,
-        clearance_at=at,
-        gravity=9.81 if args.gravity else 0.0,
-    )
+    from clearance.builders import CATALOGUE, load_scenario, rpm
+
+    if args.scenario:
+        given = [o for o, v in (("--clearance-mm", args.clearance_mm), ("--clearance-at", args.clearance_at),
+                                ("--rpm", args.rpm)) if v is not None]
+        if given:
+            raise ValueError(f"{', '.join(given)}: give these in the scenario file {args.scenario}, not with --scenario")
+        return load_scenario(args.scenario)
+    builder = CATALOGUE[args.mechanism].builder
+    accepted = inspect.signature(builder).parameters
+    kw = {}
+    if args.clearance_mm is not None:
+        kw["radial_clearance"] = args.clearance_mm * 1e-3
+    if args.clearance_at is not None:
+        kw["clearance_at"] = tuple(args.clearance_at)
+    if args.rpm is not None:
+        kw["crank_speed"] = rpm(args.rpm)
+    if args.gravity:
+        kw["gravity"] = 9.81
+    refused = [k for k in kw if k not in accepted]
+    if refused:
+        raise ValueError(f"mechanism '{args.mechanism}' does not take {refused} from the command line; "
+                         "use a scenario file (--scenario)")
+    return builder(**kw)
 
 
 def _options(args):

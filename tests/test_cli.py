@@ -51,3 +51,18 @@ def test_reference_command(tmp_path):
     rows = list(csv.DictReader((out / "summary.csv").open()))
     assert float(rows[0]["peak_force"]) > 1e3  # REFERENCES.md section 3: forces of order 1e4 N
     assert (out / "orbit_rod_slider.png").stat().st_size > 0
+
+
+def test_catalogue_mechanism_and_scenario_file(tmp_path):
+    from importlib.resources import files
+
+    path = tmp_path / "fb.xml"
+    assert main(["mjcf", "--mechanism", "four_bar", "--segments", "36", "--out", str(path)]) == 0
+    assert mujoco.MjModel.from_xml_path(str(path)).npair == 36  # one clearance joint (B) by default
+    toml = files("clearance.builders") / "scenarios" / "slider_crank.toml"
+    assert main(["mjcf", "--scenario", str(toml), "--segments", "36", "--out", str(path)]) == 0
+
+
+def test_option_the_builder_lacks_is_refused(capsys):
+    assert main(["mjcf", "--mechanism", "seven_bar_press", "--rpm", "100"]) == 2
+    assert "does not take" in capsys.readouterr().err
