@@ -53,7 +53,7 @@ def main() -> None:
                 f = r.joints["rod_slider"].force_magnitude.max()
                 cells.append(f"{100 * (f / fr - 1):+.1f} %")
             except Exception as err:  # the error a user sees is the result here
-                cells.append(f"{type(err).__name__}: {str(err).split('.')[0]}")
+                cells.append(f"{type(err).__name__}: {str(err).split(';')[0]}")
         lines.append(f"| {name} | {fr / 1e3:.2f} | " + " | ".join(cells) + " |")
         print(lines[-1], flush=True)
     lines += [
