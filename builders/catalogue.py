@@ -162,4 +162,4 @@ def check_linkage(mechanism: Mechanism, info: LinkageInfo, *, samples: int = 721
         worst = min(worst, float(np.min(np.minimum(mu, 180.0 - mu))))
     outs = {o.name: (float(kin.outputs[o.name].min()), float(kin.outputs[o.name].max())) for o in mechanism.outputs}
     acc = {o.name: float(np.max(np.abs(kin.outputs[o.name + "_acc"]))) for o in mechanism.outputs}
-    return LinkageCheck(trans, worst, float(kin.singularity.min()), outs, acc, period)
+    return LinkageCheck(trans, worst, float(np.nanmin(kin.singularity)), outs, acc, period)

@@ -183,7 +183,9 @@ class KinematicsResult:
         times: (n,) [s].
         q, qd, qdd: (n, nq) coordinates and their derivatives [m, rad, ...].
         outputs: name -> (n,) position [m or rad], plus ``<name>_vel`` and ``<name>_acc``.
-        singularity: (n,) `singularity_measure` at each time (1 is best, 0 singular).
+        singularity: (n,) `singularity_measure` at each time (1 is best, 0 singular); for
+            more than 2048 times only at the continuation points and 2048 evenly spread
+            times, NaN elsewhere (use ``np.nanmin``).
     """
 
     times: np.ndarray
@@ -313,7 +315,11 @@ def solve_kinematics(
         for k in np.flatnonzero(~ok):
             i = rest[k]
             q[i] = _track(cs, q[iL[k]], times[iL[k]], times[i], max_step, tol, singular_tol)
-    measure = cs.singularity_measure(q)
+    # the measure (an SVD per time) at every time for up to 2048 times, else at the
+    # continuation points and an even subsample of 2048 (NaN elsewhere)
+    measure = np.full(n, np.nan)
+    where = np.arange(n) if n <= 2048 else np.union1d(tr, np.linspace(0, n - 1, 2048).astype(int))
+    measure[where] = cs.singularity_measure(q[where])
     bad = np.flatnonzero(measure < singular_tol)
     if len(bad):
         raise _singular_error(cs, float(times[bad[0]]), float(measure[bad[0]]), "reaches a singular position")
