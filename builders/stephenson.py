@@ -1,9 +1,10 @@
 """Stephenson six-bar linkages: type I (plain and with slider) and type II (1) and (2).
 
-In Stephenson's chain the two ternary links are not joined directly. The inversions are
-named by the fixed link (as in the kinematic-synthesis literature, e.g. Plecnik and
-McCarthy): type I fixes a binary link that joins both ternaries, type II fixes a ternary
-link, type III a binary link next to one ternary only. Inputs, outputs, sliders and the
+In Stephenson's chain the two ternary links are not joined directly. Textbooks number its
+inversions differently; here they are defined by the fixed link (the numbering we recall
+from the kinematic-synthesis literature, not checked against a textbook): type I fixes a
+binary link that joins both ternaries, type II fixes a ternary link, type III a binary
+link next to one ternary only. Inputs, outputs, sliders and the
 variants (1) and (2) are the project's own choices (REFERENCES.md section 5 and
 CLARIFICATIONS.md: the source shows them only in figures we do not have):
 
