@@ -79,6 +79,10 @@ def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -
         angle[:, k] = d.start_angle + g * get(f"{d.name}__angle")[:, 0]
         speed[:, k] = g * get(f"{d.name}__speed")[:, 0]
         torque[:, k] = get(f"{d.name}__torque")[:, 0]
+        arm = float(model.dof_armature[model.jnt_dofadr[model.joint(d.joint).id]])
+        if arm and n > 1:
+            # torque passed to the mechanism = actuator torque - armature inertial torque
+            torque[:, k] -= arm * np.gradient(speed[:, k], times)
 
     cuts = prepared.built.tree.ideal_cuts
     if cuts:

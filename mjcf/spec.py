@@ -30,7 +30,7 @@ from clearance.mjcf.tree import BodyTree, body_tree
 from clearance.model import DriveKind, Joint, JointType, Mechanism, OutputKind
 from clearance.options import GeomType, ModelOptions
 
-__all__ = ["BuiltModel", "build_spec", "drive_gear", "ring_geometry"]
+__all__ = ["BuiltModel", "build_spec", "drive_armature", "drive_gear", "ring_geometry"]
 
 _OBJ = mujoco.mjtObj
 _SENS = mujoco.mjtSensor
@@ -239,6 +239,7 @@ def build_spec(
             act.set_to_motor()
         else:
             act.set_to_velocity(kv=_drive_gain(mechanism, options))
+            spec.joint(d.joint).armature = drive_armature(mechanism)
         _sensor(spec, f"{d.name}__angle", _SENS.mjSENS_JOINTPOS, _OBJ.mjOBJ_JOINT, d.joint)
         _sensor(spec, f"{d.name}__speed", _SENS.mjSENS_JOINTVEL, _OBJ.mjOBJ_JOINT, d.joint)
         _sensor(spec, f"{d.name}__torque", _SENS.mjSENS_ACTUATORFRC, _OBJ.mjOBJ_ACTUATOR, d.name)
@@ -256,6 +257,19 @@ def _drive_gain(mechanism: Mechanism, options: ModelOptions) -> float:
     """
     inertia = sum(lk.inertia + lk.mass * (lk.com[0] ** 2 + lk.com[1] ** 2) for lk in mechanism.moving_links)
     return 1e3 * max(inertia, 1e-6) / options.timestep
+
+
+def drive_armature(mechanism: Mechanism) -> float:
+    """Armature [kg m^2] of a speed-driven joint: 100 x the links' inertias about their frames.
+
+    The velocity actuator's gain acts only in the implicit integration, which the
+    constraint solver does not see: with two speed-driven cranks in one loop (the press)
+    the loop closure then fights the drives and the run blows up. A heavy armature makes
+    the solver see a crank that the drive holds (tests/test_catalogue_mujoco.py); its
+    inertial torque is removed from the reported drive torque.
+    """
+    inertia = sum(lk.inertia + lk.mass * (lk.com[0] ** 2 + lk.com[1] ** 2) for lk in mechanism.moving_links)
+    return 100.0 * inertia
 
 
 def _site(body, name: str, p: tuple[float, float]) -> None:

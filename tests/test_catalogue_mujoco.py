@@ -25,15 +25,12 @@ SEGMENTS = 8
 # the simulator's omega*h < 2 sizing), six times coarser than the 1 us default
 STEP = 6e-6
 PRESS_STEP = 1e-5  # limit 1.7e-5 s at the press's joint E
-# the press's two velocity-driven cranks close one loop; with the default closure time
-# constant (2 h) that loop goes unstable in MuJoCo, 1 ms keeps it within 13 um (measured)
-PRESS_CLOSURE = 1e-3
 
 
 def _setup(name: str) -> tuple[dict, ModelOptions]:
     if name == "seven_bar_press":
-        return {"crank2_speed": 3 * math.pi}, ModelOptions(timestep=PRESS_STEP, segments=SEGMENTS,
-                                                            closure_timeconst=PRESS_CLOSURE)
+        # two speed-driven cranks close one loop: default closures hold it (drive armature)
+        return {"crank2_speed": 3 * math.pi}, ModelOptions(timestep=PRESS_STEP, segments=SEGMENTS)
     return {"crank_speed": rpm(1000)}, ModelOptions(timestep=STEP, segments=SEGMENTS)
 
 
@@ -63,8 +60,8 @@ def test_ideal_twin_matches_kinematics(name):
         err = np.max(np.abs(r.outputs[o.name] - kin.outputs[o.name]))
         span = np.ptp(kin.outputs[o.name])
         # measured 2e-7 to 1.7e-6 of the output range (soft loop closures with a 2 h time
-        # constant, velocity servo error); the press, with 1 ms closures, 1.3e-4
-        tol = 1e-3 if name == "seven_bar_press" else 1e-5
+        # constant, velocity servo error)
+        tol = 1e-5
         assert err < tol * span, (o.name, err, span)
         verr = np.max(np.abs(r.outputs[o.name + "_vel"] - kin.outputs[o.name + "_vel"]))
         vspan = np.ptp(kin.outputs[o.name + "_vel"])
@@ -72,9 +69,6 @@ def test_ideal_twin_matches_kinematics(name):
         # (measured ~h/2 * |a|): h * max|a| plus the position bound's relative error
         h = r.metadata["time_step"]
         bound = h * np.max(np.abs(kin.outputs[o.name + "_acc"])) + tol * vspan
-        if name == "seven_bar_press":
-            # its softened (1 ms) closures let the velocity ring: measured 0.4 % of the range
-            bound = 1e-2 * vspan
         assert verr < bound, (o.name, verr, bound)
 
 
@@ -93,6 +87,5 @@ def test_runs_one_cycle_without_warnings(name, clearance_at):
     for jr in r.joints.values():
         assert np.all(np.isfinite(jr.contact_force)) and np.all(np.isfinite(jr.eccentricity))
     # ideal loop closures (connect equalities at a 2 h time constant): measured up to 4e-7 m
-    # across the matrix; 5 um bound. The press's softened closures measured 13 um: 50 um bound
-    bound = 5e-5 if name == "seven_bar_press" else 5e-6
-    assert np.max(r.closure_violation) < bound
+    # across the matrix; 5 um bound
+    assert np.max(r.closure_violation) < 5e-6
