@@ -32,16 +32,15 @@ def _positive(text: str) -> float:
 
 
 def _builder(name: str):
-    import clearance.builders as catalogue
+    from clearance.builders import CATALOGUE
 
-    names = [n for n in getattr(catalogue, "__all__", []) if n.islower() and n != "rpm"]
-    if name not in names:
-        raise SystemExit(f"error: unknown mechanism {name!r}; choose one of {names}")
-    return getattr(catalogue, name)
+    if name not in CATALOGUE:
+        raise SystemExit(f"error: unknown mechanism {name!r}; choose one of {sorted(CATALOGUE)}")
+    return CATALOGUE[name].builder
 
 
 def _common(p: argparse.ArgumentParser, out: str) -> None:
-    p.add_argument("--mechanism", default="slider_crank", help="builder in clearance.builders (default slider_crank)")
+    p.add_argument("--mechanism", default="slider_crank", help="catalogue mechanism (default slider_crank)")
     p.add_argument("--timestep-us", type=_positive, default=5.0, help="time step [µs] (default 5)")
     p.add_argument("--segments", type=int, default=None, help="bearing segments N (default: ripple rule)")
     p.add_argument("--out", default=out, help=f"output folder (default {out}); rerun to resume")

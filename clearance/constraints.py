@@ -51,6 +51,22 @@ class _Pair:
     offset: float  # prismatic: theta_b - theta_a
 
 
+class _Held:
+    """A torque drive seen by kinematics: its joint held at the start angle, at rest."""
+
+    def __init__(self, name: str, angle: float) -> None:
+        self.name = name
+        self.start_angle = angle
+
+    def angle(self, t):
+        return self.start_angle + 0.0 * np.asarray(t, dtype=float)
+
+    def rate(self, t):
+        return 0.0 * np.asarray(t, dtype=float)
+
+    acceleration = rate
+
+
 class ConstraintSystem:
     """Constraints Phi(q, t) = 0 of a mechanism's ideal joints and prescribed drives.
 
@@ -63,7 +79,10 @@ class ConstraintSystem:
         include_clearance: if True (default) clearance joints count as ideal revolute
             joints; if False they are left out (their links are then held by contact).
         include_drives: if True (default) each constant-speed or motion-law drive adds one
-            rheonomic row theta_b - theta_a - angle(t) = 0. Torque drives never add a row.
+            rheonomic row theta_b - theta_a - angle(t) = 0, and each torque drive a row
+            holding its joint at the drive's start angle (so a torque-driven mechanism
+            assembles, at rest, in the pose its start angles give). The reference solver,
+            which applies torque drives as torques, builds its system without them.
     """
 
     def __init__(
@@ -92,10 +111,9 @@ class ConstraintSystem:
         self.drives = []
         if include_drives:
             for d in mechanism.drives:
-                if d.kind is DriveKind.TORQUE:
-                    continue
                 jt = mechanism.joint(d.joint)
-                self.drives.append((d, index[jt.link_a], index[jt.link_b]))
+                law = _Held(d.name, d.start_angle) if d.kind is DriveKind.TORQUE else d
+                self.drives.append((law, index[jt.link_a], index[jt.link_b]))
         self.n_constraints = 2 * len(self.pairs) + len(self.drives)
         self.length_scale = _length_scale(mechanism)
         # vectorised tables; the ground is the extra link block n_links (always at rest)

@@ -190,6 +190,7 @@ def choose_segments(
     ripple_limit: float = 0.02,
     flat: bool = False,
     candidates: tuple[int, ...] = SEGMENT_CANDIDATES,
+    fallback_max: int = 288,
 ) -> int:
     """Smallest N whose force ripple stays under ``ripple_limit`` at the typical depth.
 
@@ -197,18 +198,31 @@ def choose_segments(
     repeat), so the rule asks for the limit to hold over a band of depths, from half to
     twice ``typical_penetration`` [m], not at one depth.
 
+    When no candidate meets the limit (light loads: the journal barely touches, as in a
+    slow mechanism), the candidate up to ``fallback_max`` with the smallest ripple is
+    returned and a `RuntimeWarning` says so.
+
     Raises:
-        ValueError: no candidate meets the limit (the journal barely touches; give N).
+        ValueError: a non-positive typical penetration.
     """
     if typical_penetration <= 0:
         raise ValueError(f"typical_penetration must be > 0 (got {typical_penetration!r} m)")
     band = typical_penetration * np.array([0.5, 0.71, 1.0, 1.41, 2.0])
+    best = (math.inf, candidates[0])
     for n in candidates:
         geom = RingGeometry.make(bearing_radius, radial_clearance, n, flat=flat)
-        if max(force_ripple(geom, float(d), n_dir=96) for d in band) < ripple_limit:
+        ripple = max(force_ripple(geom, float(d), n_dir=96) for d in band)
+        if ripple < ripple_limit:
             return n
-    raise ValueError(
-        f"no segment count up to {candidates[-1]} keeps the force ripple under "
-        f"{ripple_limit:.1%} at penetration {typical_penetration:.3g} m for clearance "
-        f"{radial_clearance:.3g} m; give ModelOptions(segments=...) explicitly"
+        if n <= fallback_max and ripple < best[0]:
+            best = (ripple, n)
+    import warnings
+
+    warnings.warn(
+        f"no segment count up to {candidates[-1]} keeps the force ripple under {ripple_limit:.1%} at "
+        f"penetration {typical_penetration:.3g} m (clearance {radial_clearance:.3g} m); using N = {best[1]} "
+        f"(ripple {best[0]:.1%}); give ModelOptions(segments=...) to choose",
+        RuntimeWarning,
+        stacklevel=2,
     )
+    return best[1]

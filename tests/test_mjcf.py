@@ -87,3 +87,10 @@ def test_ring_is_hertz_like_and_ripple_rule():
     n = choose_segments(0.01, 0.5e-3, 6e-6)
     assert force_ripple(RingGeometry.make(0.01, 0.5e-3, n), 6e-6) < 0.02
     assert GeomType("box") is GeomType.BOX
+
+
+def test_segment_rule_falls_back_with_a_warning_at_light_load():
+    # 0.1 um typical penetration (a slow mechanism): no N up to 512 keeps ripple under 2 %
+    with pytest.warns(RuntimeWarning, match="using N = "):
+        n = choose_segments(0.01, 0.5e-3, 1e-7)
+    assert 8 <= n <= 288

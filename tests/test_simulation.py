@@ -147,3 +147,17 @@ def test_exact_ln_mode_runs_the_whole_mechanism():
     f, fr = r.joints["rod_slider"].force_magnitude, ref.joints["rod_slider"].force_magnitude
     assert f.max() == pytest.approx(fr.max(), rel=0.01)
     assert r.metadata["contact_mode"] == "exact_ln"
+
+
+def test_torque_drive_starts_at_rest_in_its_start_pose():
+    import dataclasses
+
+    from clearance import Drive, DriveKind
+
+    base = slider_crank(clearance_at=())
+    mech = dataclasses.replace(base, drives=(Drive("crank", "crank_pivot", DriveKind.TORQUE, torque=2.0, start_angle=0.5),))
+    r = simulate(mech, duration=0.01, options=ModelOptions(timestep=1e-5))
+    assert r.drive_angle[0, 0] == pytest.approx(0.5, abs=1e-12)  # assembled at the start angle
+    assert r.drive_speed[0, 0] == 0.0
+    assert np.all(r.drive_torque[:, 0] == 2.0)  # a motor passes its control unchanged
+    assert r.drive_speed[-1, 0] > 1.0  # and a positive torque spins the crank up
