@@ -5,11 +5,25 @@ m δ̈ = −F(δ, δ̇, v), integrated with `scipy.integrate.solve_ivp` (DOP853)
 
 Separation is defined as δ returning to 0 with δ̇ < 0. Where a law's damping term outgrows
 the elastic one during restitution the laws clip at 0 instead of pulling, and the mass flies
-free inside the penetration zone at constant δ̇; the integrator follows that with F = 0, so
-the restitution is the speed at which the mass finally leaves the zone. For the laws
-K δⁿ [1 + χ δ̇/δ̇⁻] the force only tends to 0 as |δ̇| nears δ̇⁻/χ (so cₑ_eff <= 1/χ); the
-IMPACT law releases in finite time and, as its damping fades like δ² while K δⁿ fades like
-δ^1.5, pushes again just before δ = 0.
+free inside the penetration zone at constant δ̇, so the restitution is the speed at which
+the mass finally leaves the zone. For the laws K δⁿ [1 + χ δ̇/δ̇⁻] the force only tends to 0
+as |δ̇| nears δ̇⁻/χ (so cₑ_eff <= 1/χ); the IMPACT law releases in finite time and, as its
+damping fades like δ² while K δⁿ fades like δ^1.5, pushes again just before δ = 0 (below
+0.77 µm = 0.028 δ_s at C_max = 1e4 N s/m, d_max = 10 µm, 0.21 kg, 1 m/s, K = 6.6e10 N/m^1.5).
+
+Switches: the force has a kink where the law lets go of a receding mass and another at
+δ = 0, and one step can straddle a kink, or a whole thin region of contact, without its
+error estimate noticing (a 0.5 t_s coasting step over that IMPACT re-push region lost
+1.5e-4 of the restitution at rtol 1e-10). So:
+
+- letting go (F turning 0 with δ > 0, δ̇ < 0) and separation are terminal events, and the
+  step that carried one is taken again, from its start, to end on the located switch
+  (integration goes on from there if the re-taken step has not switched yet);
+- the flight with F = 0 is a straight line and is followed exactly. The force is sampled
+  along it, at 1/512 steps of the penetration at release and then halving towards δ = 0
+  (down to 2^-52 of it); the first pushing sample is bracketed, bisected to rounding, and
+  integration restarts there. A region of contact narrower than 1/512 of that penetration
+  and away from δ = 0 can be missed.
 
 Scales: the integration runs in units of a Hertz-type penetration δ_s (where the
 elastic work F(δ_s, 0, v) δ_s / 2.5 equals the kinetic energy ½ m v²) and of v, with time
@@ -18,10 +32,11 @@ mass 0.01..10 kg and speed 0.001..20 m/s (the scaled Hertz and LN problems are i
 over that whole range).
 
 Solver: DOP853 with max_step 0.5 t_s. Measured on an LN impact (cₑ = 0.9) against a
-rtol = 1e-13 run: DOP853 at rtol 1e-10 gives a restitution error of 4e-10 in 530 force
-calls (about 3 ms of integration); LSODA 3e-9 in 340; RK45 4e-9 in 610; Radau 8e-12 in
-3000 calls (47 ms). A heavily damped IMPACT law (C_max >~ 1e6 N s/m at 0.2 kg) is stiff and
-takes tens to hundreds of ms, but remains accurate.
+rtol = 1e-13 run: DOP853 at rtol 1e-10 gives a restitution error of 2e-10 in 610 force
+calls (about 3.5 ms of integration; 530 calls and 4e-10 before the last step was re-taken);
+without the re-take, LSODA 3e-9 in 340; RK45 4e-9 in 610; Radau 8e-12 in 3000 calls
+(47 ms). A heavily damped IMPACT law (C_max >~ 1e6 N s/m at 0.2 kg) is stiff and takes tens
+to hundreds of ms, but remains accurate.
 """
 
 from __future__ import annotations
@@ -32,7 +47,7 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from scipy.integrate import solve_ivp
+from scipy.integrate import DenseOutput, OdeSolution, solve_ivp
 from scipy.optimize import minimize_scalar
 from scipy.special import beta
 
@@ -54,6 +69,10 @@ ForceLaw = Callable[[Any, Any, float], Any]
 
 _MAX_STEP = 0.5  # in units of t_s; the Hertz contact lasts about 3 t_s
 _FIRST_STEP = 1e-4  # in units of t_s
+_MAX_PHASES = 100  # integration runs per impact, each ended by a release or a re-take
+# Where a coasting mass is tested for renewed contact, as fractions of the penetration at
+# release: uniformly in steps of 1/512, then halving down to 2^-52 towards δ = 0.
+_COAST_GRID = np.concatenate((np.arange(511, 0, -1) / 512, 2.0 ** -np.arange(10, 53)))
 
 
 @dataclass(frozen=True)
@@ -175,6 +194,44 @@ def _eval_force(force: ForceLaw, d: np.ndarray, dd: np.ndarray, v: float) -> np.
     return np.array([float(force(a, b, v)) for a, b in zip(d, dd)])
 
 
+class _Coast(DenseOutput):
+    """Force-free flight from state y0 at t_old: δ moves at the constant rate δ̇."""
+
+    def __init__(self, t_old: float, t: float, y0: np.ndarray) -> None:
+        super().__init__(t_old, t)
+        self.y0 = np.array(y0, dtype=float)
+        self.rate = np.zeros_like(self.y0)
+        self.rate[0] = self.y0[1]
+
+    def _call_impl(self, t: np.ndarray) -> np.ndarray:
+        dt = np.asarray(t, dtype=float) - self.t_old
+        if dt.ndim == 0:
+            return self.y0 + self.rate * dt
+        return self.y0[:, None] + self.rate[:, None] * dt
+
+
+def _reengagement(force: ForceLaw, delta: float, rate: float, v: float) -> float:
+    """Fraction u in [0, 1) of ``delta`` at which a mass coasting at ``rate`` < 0 is pushed.
+
+    The first grid point (from u = 1 down) where the force is non-zero brackets, with the
+    one before it, a switch that bisection narrows to rounding; the returned u is on the
+    pushing side. 0 if the force stays 0 all the way to δ = 0.
+    """
+    f = _eval_force(force, delta * _COAST_GRID, np.full(_COAST_GRID.shape, rate), v)
+    hit = np.flatnonzero(f > 0)
+    if not hit.size:
+        return 0.0
+    k = int(hit[0])
+    lo, hi = float(_COAST_GRID[k]), (1.0 if k == 0 else float(_COAST_GRID[k - 1]))
+    while hi - lo > 4 * np.finfo(float).eps * hi:
+        mid = 0.5 * (lo + hi)
+        if float(force(delta * mid, rate, v)) > 0:
+            lo = mid
+        else:
+            hi = mid
+    return lo
+
+
 def _simulate(
     force: ForceLaw, mass: Any, speed: Any, tangential_speed: float | None,
     friction: float, v0: float, v1: float, rtol: float, atol: float | None,
@@ -215,30 +272,92 @@ def _simulate(
     def turning(_: float, y: np.ndarray) -> float:
         return y[1]
 
+    def released(_: float, y: np.ndarray) -> float:
+        # > 0 while the law pushes; -1 once it has let go of a receding mass inside the
+        # zone. The jump is a sign change that brentq locates to rounding.
+        f = float(force(d_s * y[0], v * y[1], v))
+        if f > 0:
+            return gain * f
+        return -1.0 if y[0] > 0 and y[1] < 0 else 1.0
+
     separation.terminal, separation.direction = True, -1  # type: ignore[attr-defined]
     turning.direction = -1  # type: ignore[attr-defined]
-    y0 = [0.0, 1.0] + ([w0 / v] if oblique else [])
-    sol = solve_ivp(
-        rhs, (0.0, t_end), y0, method="DOP853", rtol=rtol, atol=atol, dense_output=True,
-        events=(separation, turning), max_step=_MAX_STEP, first_step=_FIRST_STEP,
-    )
-    if sol.status != 1:
-        raise RuntimeError(
-            f"no separation within {t_end * t_s:.3g} s (solver: {sol.message}); raise "
-            "max_duration for a strongly damped law"
+    released.terminal, released.direction = True, -1  # type: ignore[attr-defined]
+
+    def no_separation(message: str) -> RuntimeError:
+        return RuntimeError(
+            f"no separation within {t_end * t_s:.3g} s ({message}); raise max_duration for "
+            "a strongly damped law"
         )
-    tau_sep = float(sol.t_events[0][0])
-    y_sep = sol.y_events[0][0]
-    dmax = d_s * float(sol.y_events[1][0][0]) if len(sol.t_events[1]) else 0.0
+
+    def integrate(t0: float, t1: float, y0: np.ndarray, first_step: float | None) -> Any:
+        return solve_ivp(
+            rhs, (t0, t1), y0, method="DOP853", rtol=rtol, atol=atol, dense_output=True,
+            events=(separation, turning, released), max_step=_MAX_STEP, first_step=first_step,
+        )
+
+    ts: list[float] = [0.0]
+    pieces: list[DenseOutput] = []
+    turns: list[tuple[float, float]] = []  # (τ, δ/δ_s) where δ̇ turns negative
+
+    def keep(sol: Any, n: int) -> None:
+        """Keep the first n steps of a run: its interpolants and turning points."""
+        for t1, piece in zip(sol.t[1 : n + 1], sol.sol.interpolants[:n]):
+            if t1 > ts[-1]:  # a switch found where a run starts ends it with a null step
+                ts.append(t1)
+                pieces.append(piece)
+        turns.extend((te, ye[0]) for te, ye in zip(sol.t_events[1], sol.y_events[1])
+                     if te <= sol.t[n])
+
+    t, y = 0.0, np.array([0.0, 1.0] + ([w0 / v] if oblique else []))
+    first, redone = _FIRST_STEP, math.nan
+    for _ in range(_MAX_PHASES):
+        sol = integrate(t, t_end, y, first)
+        if sol.status == 1 and sol.t[-2] != redone and sol.t[-1] > sol.t[-2]:
+            # The step that carried the switch (separation or release) can straddle a force
+            # kink its error estimate does not see; take that step again so it ends on the
+            # switch as located, and go on from there if it has not switched yet.
+            keep(sol, len(sol.t) - 2)
+            sol = integrate(sol.t[-2], sol.t[-1], sol.y[:, -2], None)
+            if sol.status == 0:
+                keep(sol, len(sol.t) - 1)
+                t, y, first, redone = sol.t[-1], sol.y[:, -1], None, sol.t[-1]
+                continue
+        if sol.status != 1:
+            raise no_separation(f"solver: {sol.message}")
+        keep(sol, len(sol.t) - 1)
+        if len(sol.t_events[0]):
+            tau_sep, y_sep = float(sol.t_events[0][0]), sol.y_events[0][0]
+            break
+        # Released: coast in a straight line to where the law pushes again, or to δ = 0.
+        t_rel, y_rel = float(sol.t_events[2][0]), sol.y_events[2][0]
+        u = _reengagement(force, d_s * y_rel[0], v * y_rel[1], v)
+        t = t_rel + y_rel[0] * (1.0 - u) / -y_rel[1]
+        if t > t_end:
+            raise no_separation("coasting")
+        pieces.append(_Coast(t_rel, t, y_rel))
+        ts.append(t)
+        y = pieces[-1](t)
+        y[0] = y_rel[0] * u
+        if u == 0.0:
+            tau_sep, y_sep = t, y
+            break
+        first, redone = None, math.nan
+    else:
+        raise RuntimeError(
+            f"no separation after {_MAX_PHASES} switches between pushing and coasting"
+        )
+    dmax = d_s * min(turns)[1] if turns else 0.0
+    traj = OdeSolution(ts, pieces)
 
     tau = np.linspace(0.0, tau_sep, n_samples)
-    y = sol.sol(tau)
+    y = traj(tau)
     y[:, -1] = y_sep
     delta, rate = d_s * y[0], v * y[1]
     f = _eval_force(force, delta, rate, v)
 
     def neg_force(t: float) -> float:
-        yy = sol.sol(t)
+        yy = traj(t)
         return -float(force(d_s * yy[0], v * yy[1], v))
 
     i = int(np.argmax(f))
