@@ -14,6 +14,10 @@ in. Each finished row is written at once to ``<out_dir>/points/point_<index>.jso
 Running the same sweep again skips the points that have files, so an interrupted sweep
 resumes where it stopped. Rows hold no wall times (those go to ``timing`` in the JSON
 only), so a resumed sweep's table equals an uninterrupted one's.
+
+Points that share an ideal twin (a criticality grid has one per drive speed) reuse its run
+within a worker (`clearance.analysis.ideal_runs`); runs are deterministic, so rows do not
+change.
 """
 
 from __future__ import annotations
@@ -32,6 +36,7 @@ from typing import Any
 
 import numpy as np
 
+from clearance.analysis.ideal_runs import ideal_run
 from clearance.results import atomic_write_text
 
 __all__ = ["KeywordFactory", "SweepEvaluation", "SweepOutcome", "evaluate_point", "load_rows", "run_sweep"]
@@ -186,23 +191,33 @@ def evaluate_point(
         needs_ideal: also simulate the ideal twin.
 
     Returns:
-        The row (JSON-compatible dict) with ``timing`` added.
+        The row (JSON-compatible dict) with ``timing`` added: ``wall_time_s`` (whole
+        point), ``simulate_s`` (model preparation and stepping of the run with
+        clearance), ``stepping_s`` (its stepping and sensor readout alone), ``ideal_s``
+        (the ideal twin's run, 0 when reused), ``ideal_reused``, ``evaluate_s`` (the
+        evaluation), all in seconds, and ``pid``.
     """
     from clearance.simulation import default_duration, simulate
 
     t0 = time.perf_counter()
+    timing: dict[str, Any] = {}
     row: dict[str, Any] = {"index": index, "point": dict(point), "status": "ok", "error": ""}
     try:
         mech = make_mechanism(point)
         dur = duration(mech) if callable(duration) else (duration or default_duration(mech))
+        t1 = time.perf_counter()
         res = simulate(mech, duration=dur, options=options)
-        ideal = simulate(mech.ideal_twin(), duration=dur, options=options) if needs_ideal else None
+        t2 = time.perf_counter()
+        timing.update(simulate_s=t2 - t1, stepping_s=res.metadata.get("wall_time_s"))
+        ideal = ideal_run(mech, dur, options, timing) if needs_ideal else None
+        t3 = time.perf_counter()
         row.update(evaluation(res, ideal, mech))
+        timing["evaluate_s"] = time.perf_counter() - t3
     except Exception as err:  # noqa: BLE001 - recorded in the row, the sweep goes on
         row["status"] = "error"
         row["error"] = f"{type(err).__name__}: {err}"
     row = _json_safe(row)
-    row["timing"] = {"wall_time_s": time.perf_counter() - t0, "pid": os.getpid()}
+    row["timing"] = {"wall_time_s": time.perf_counter() - t0, "pid": os.getpid(), **_json_safe(timing)}
     return row
 
 
