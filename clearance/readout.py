@@ -57,6 +57,9 @@ def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -
             comp = 0 if o.kind is OutputKind.POSITION_X else 1
             for suffix, key in (("pos", o.name), ("vel", o.name + "_vel"), ("acc", o.name + "_acc")):
                 outputs[key] = get(f"{o.name}__{suffix}")[:, comp].copy()
+            # MuJoCo's frame linear acceleration includes -gravity (as an accelerometer
+            # reads it); the output is the kinematic acceleration
+            outputs[o.name + "_acc"] += model.opt.gravity[comp]
 
     joints: dict[str, JointResult] = {}
     for jname, ring in prepared.built.rings.items():
