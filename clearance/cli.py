@@ -6,6 +6,7 @@
     clearance calibrate  fit contact parameters to LN impacts and write a report
     clearance sweep      bifurcation diagram over clearance or drive speed (resumable)
     clearance rank       joint criticality ranking (resumable)
+    clearance bench      speed against error of MuJoCo settings (resumable)
 
 Units on the command line are the ones people use (mm, rpm, µs); they are converted to SI
 here, once.
@@ -109,6 +110,7 @@ _FORWARDED = {
     "sweep": ("clearance.analysis.cli_commands", "main_sweep",
               "bifurcation diagram over clearance or drive speed (resumable sweep)"),
     "rank": ("clearance.analysis.cli_commands", "main_rank", "joint criticality ranking (resumable sweep)"),
+    "bench": ("clearance.bench", "main_bench", "speed against error of MuJoCo settings against the reference solver"),
 }
 
 

@@ -150,9 +150,8 @@ def simulate_prepared(
                    _remedy(prepared))
         if bad is not None:
             idx, joint, why, remedy = bad
-            keep = part.sliced(slice(0, idx))
-            parts.append(keep)
-            result = _finish(parts, every, prepared, t0, nstep_done=done + idx)
+            parts.append(_thin(part.sliced(slice(0, idx)), done, every))
+            result = _finish(parts, prepared, t0, nstep_done=done + idx, every=every)
             tb = float(times[min(idx, n - 1)])
             raise SimulationError(
                 f"simulation diverged at t = {tb:.6g} s{f' at joint {joint!r}' if joint else ''}: {why}. "
@@ -161,11 +160,19 @@ def simulate_prepared(
                 time=tb,
                 joint=joint,
             )
-        parts.append(part)
+        parts.append(_thin(part, done, every))
         done += n
         bar(done)
     bar(None)
-    return _finish(parts, every, prepared, t0, nstep_done=nstep)
+    return _finish(parts, prepared, t0, nstep_done=nstep, every=every)
+
+
+def _thin(part, first_step: int, every: int):
+    """Rows of a chunk starting at step ``first_step`` whose step index is a multiple of ``every``.
+
+    Thinning each chunk as it comes keeps memory bounded by the stored rows, not the steps.
+    """
+    return part if every == 1 else part.sliced(slice((-first_step) % every, None, every))
 
 
 class _StepFailure(Exception):
@@ -261,12 +268,12 @@ def _remedy(prepared: PreparedModel) -> str:
     )
 
 
-def _finish(parts, every, prepared: PreparedModel, t0: float, *, nstep_done: int):
+def _finish(parts, prepared: PreparedModel, t0: float, *, nstep_done: int, every: int):
     from clearance.results import SimulationResult
 
     if not parts:
         return None
-    res = SimulationResult.concatenate(parts).decimated(every)
+    res = SimulationResult.concatenate(parts)
     wall = _time.perf_counter() - t0
     mech = prepared.mechanism
     res.metadata = {
