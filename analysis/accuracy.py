@@ -165,10 +165,11 @@ def _joint_stats(times: np.ndarray, jr, period: float) -> dict[str, float]:
     f, p = jr.force_magnitude, jr.penetration
     contact = p > 0
     e = np.hypot(*jr.eccentricity.T)
-    revs = np.floor((times - times[0]) / period).astype(int)
+    dt = float(np.median(np.diff(times))) if len(times) > 1 else period
+    revs = np.floor((times - times[0] + 0.5 * dt) / period).astype(int)  # half a sample: no float slivers
     peaks = [f[revs == k].max() for k in np.unique(revs)]
     onsets = int(np.count_nonzero(contact[1:] & ~contact[:-1]))
-    span = len(times) * float(np.median(np.diff(times))) if len(times) > 1 else period
+    span = len(times) * dt
     return {
         "peak_force": float(np.mean(peaks)),
         "p95_force": float(np.percentile(f[contact], 95)) if contact.any() else 0.0,
@@ -212,7 +213,9 @@ def run_statistics(
     if not isinstance(blocks, int) or blocks < 2:
         raise ValueError(f"blocks must be an integer >= 2 (got {blocks!r})")
     t = result.times
-    whole = int(np.floor((t[-1] - skip) / period + 1e-9)) if len(t) else 0
+    dt = float(np.median(np.diff(t))) if len(t) > 1 else 0.0
+    # a run of duration T stores samples up to T - dt: its last sample closes the last period
+    whole = int(np.floor((t[-1] + dt - skip) / period + 1e-9)) if len(t) else 0
     if whole < blocks:
         raise ValueError(
             f"the window after skip = {skip:g} s holds {whole} whole revolutions of {period:g} s; "
@@ -220,8 +223,9 @@ def run_statistics(
         )
     per_block = whole // blocks
     edges = skip + period * per_block * np.arange(blocks + 1)
-    sel = [(t >= edges[k]) & (t < edges[k + 1]) for k in range(blocks)]
-    full = (t >= edges[0]) & (t < edges[-1])
+    edges[-1] += 0.5 * dt  # keep the last block's final sample
+    sel = [(t >= edges[k] - 0.5 * dt) & (t < edges[k + 1] - 0.5 * dt) for k in range(blocks)]
+    full = (t >= edges[0] - 0.5 * dt) & (t < edges[-1] - 0.5 * dt)
     dev = None
     if ideal_output is not None:
         name = output or next(k for k in result.outputs if not k.endswith(("_vel", "_acc")))
@@ -273,25 +277,46 @@ FORCE_QUANTILES = (0.5, 0.75, 0.9, 0.95, 0.99)
 
 
 def statistic_errors(
-    run: Mapping[str, Mapping[str, Statistic]], ref: Mapping[str, Mapping[str, Statistic]]
+    run: Mapping[str, Mapping[str, Statistic]],
+    ref: Mapping[str, Mapping[str, Statistic]],
+    *,
+    clearance: Mapping[str, float] | None = None,
 ) -> dict[str, dict[str, dict[str, float]]]:
-    """Relative error of each statistic against the reference, with both scatters.
+    """Error of each statistic against the reference, with both scatters, on a stated scale.
+
+    Errors are relative to the reference's value, except where that value can be close to
+    zero: ``ecc_mean`` and ``ecc_std`` are measured in units of the joint's clearance c
+    (|e| lives in [0, c + δ]; a journal resting on its bearing has ``ecc_std`` near 0), and
+    ``impacts_per_rev`` relative to max(reference, 1) (a joint in permanent contact has
+    none).
+
+    Args:
+        run: `run_statistics` of the run.
+        ref: `run_statistics` of the reference.
+        clearance: joint -> radial clearance c [m], for the eccentricity scales (without
+            it they are relative too).
 
     Returns:
-        joint -> statistic -> {``error``: run/ref - 1, ``ref_scatter``: the reference's
-        relative standard error, ``scatter``: combined relative standard error of the
-        error, sqrt(se_run^2 + se_ref^2)/|ref|}.
+        joint -> statistic -> {``error``: (run - ref) / scale, ``ref_scatter``: the
+        reference's standard error / scale, ``scatter``: sqrt(se_run^2 + se_ref^2) /
+        scale, ``scale``: the scale}.
     """
     out: dict[str, dict[str, dict[str, float]]] = {}
     for j, stats in ref.items():
         out[j] = {}
         for k, r in stats.items():
             m = run[j][k]
-            den = abs(r.value) if r.value else float("nan")
+            if k.startswith("ecc_") and clearance and j in clearance:
+                scale = float(clearance[j])
+            elif k == "impacts_per_rev":
+                scale = max(abs(r.value), 1.0)
+            else:
+                scale = abs(r.value) if r.value else float("nan")
             out[j][k] = {
-                "error": m.value / r.value - 1.0 if r.value else float("nan"),
-                "ref_scatter": r.scatter / den,
-                "scatter": float(np.hypot(m.scatter, r.scatter)) / den,
+                "error": (m.value - r.value) / scale,
+                "ref_scatter": r.scatter / scale,
+                "scatter": float(np.hypot(m.scatter, r.scatter)) / scale,
+                "scale": scale,
             }
     return out
 

@@ -8,9 +8,11 @@ setting of a scenario:
 * first impacts (deterministic): relative errors of peak contact force, maximum
   penetration and impulse of each joint's first impact, and the time the run separates
   from the reference (journal centres more than 10 % of the clearance apart);
-* statistics (chaotic part): relative error of each statistic of
-  `clearance.analysis.accuracy.STATISTICS`, with the reference's own scatter and the
-  combined scatter of the error beside it.
+* statistics (chaotic part): error of each statistic of
+  `clearance.analysis.accuracy.STATISTICS` on the scale of
+  `clearance.analysis.accuracy.statistic_errors` (relative; eccentricity in units of the
+  clearance; impacts relative to at least one per revolution), with the reference's own
+  scatter and the combined scatter of the error beside it.
 
 A setting's *statistics error* is its worst |error| over statistics and joints; its
 *first-impact error* the worst over the three first-impact quantities and joints.
@@ -154,7 +156,7 @@ def compare_scenario(scenario: Scenario, out_dir: str | Path, *, fixed_per_rev: 
         row.first_impact = {j: first_impact_errors(_first(acc, j), _first(ref, j)) for j in ref["first_impact"]}
         row.first_impact_error = max(abs(e[k]) for e in row.first_impact.values() for k in _FIRST)
         row.separation = _separation(out, scenario.name, st.key, ref)
-        row.statistics = statistic_errors(_stats(acc), ref_stats)
+        row.statistics = statistic_errors(_stats(acc), ref_stats, clearance=ref["clearance"])
         worst = max(((abs(v["error"]), f"{j}: {k}") for j, d in row.statistics.items() for k, v in d.items()),
                     key=lambda x: -1.0 if math.isnan(x[0]) else x[0])
         row.statistics_error, row.worst_statistic = worst
@@ -163,19 +165,22 @@ def compare_scenario(scenario: Scenario, out_dir: str | Path, *, fixed_per_rev: 
 
 
 def reference_scatter(scenario: Scenario, out_dir: str | Path) -> dict[str, float]:
-    """The reference's relative standard error of each statistic (worst joint).
+    """The reference's standard error of each statistic on its error scale (worst joint).
+
+    The scales are those of `clearance.analysis.accuracy.statistic_errors`.
 
     Raises:
-        FileNotFoundError: no reference accuracy file.
+        FileNotFoundError: no usable reference accuracy file.
     """
     ref = _load(Path(out_dir) / "accuracy" / scenario.name / f"{REFERENCE}.json")
     if ref is None or ref["status"] != "ok":
         raise FileNotFoundError(f"no usable reference accuracy file for scenario '{scenario.name}'")
+    stats = _stats(ref)
+    errs = statistic_errors(stats, stats, clearance=ref["clearance"])
     out: dict[str, float] = {}
-    for d in _stats(ref).values():
-        for k, s in d.items():
-            rel = s.scatter / abs(s.value) if s.value else math.nan
-            out[k] = max(out.get(k, 0.0), rel)
+    for d in errs.values():
+        for k, e in d.items():
+            out[k] = max(out.get(k, 0.0), e["ref_scatter"])
     return out
 
 
