@@ -31,7 +31,6 @@ from __future__ import annotations
 
 import math
 import os
-import tempfile
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -41,7 +40,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from clearance.model import Mechanism
-from clearance.results import SimulationResult
+from clearance.results import SimulationResult, temporary_file_beside
 
 __all__ = [
     "DEFAULT_MAX_RATE_HZ",
@@ -403,11 +402,11 @@ def record_runs(
         raise ValueError(f"max_rate_hz must be > 0 or None (got {max_rate_hz!r})")
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, tmp = temporary_file_beside(path)  # the usual mode of a new file, not mkstemp's 0o600
     os.close(fd)
     rec = rr.RecordingStream(application_id)
     try:
-        rec.save(tmp, default_blueprint=make_blueprint(runs))
+        rec.save(str(tmp), default_blueprint=make_blueprint(runs))
         for r in runs:
             log_run(rec, r, max_rate_hz=max_rate_hz)
         rec.flush()

@@ -8,21 +8,48 @@ from __future__ import annotations
 
 import json
 import os
-import tempfile
+import secrets
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-__all__ = ["JointResult", "SimulationResult", "atomic_write_bytes", "atomic_write_text"]
+__all__ = ["JointResult", "SimulationResult", "atomic_write_bytes", "atomic_write_text", "temporary_file_beside"]
+
+
+def temporary_file_beside(path: str | os.PathLike) -> tuple[int, Path]:
+    """Create a new, empty hidden file in ``path``'s folder for an atomic write.
+
+    The file gets the mode a plain ``open(path, "w")`` gives (0o666 minus the umask), so
+    that the renamed result is readable like any other output file (`tempfile.mkstemp`
+    would make it 0o600, private to its owner).
+
+    Returns:
+        (open file descriptor for writing, path of the temporary file).
+
+    Raises:
+        OSError: the folder is not writable.
+    """
+    path = Path(path)
+    flags = os.O_WRONLY | os.O_CREAT | os.O_EXCL | getattr(os, "O_BINARY", 0)
+    for _ in range(100):
+        tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}.tmp"
+        try:
+            return os.open(tmp, flags, 0o666), tmp
+        except FileExistsError:
+            continue
+    raise FileExistsError(f"no free temporary name beside {path}")
 
 
 def atomic_write_bytes(path: str | os.PathLike, data: bytes) -> None:
-    """Write bytes to ``path`` atomically (temporary file in the same folder, then rename)."""
+    """Write bytes to ``path`` atomically (temporary file in the same folder, then rename).
+
+    The file gets the usual mode of a new file (0o666 minus the umask).
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    fd, tmp = temporary_file_beside(path)
     try:
         with os.fdopen(fd, "wb") as fh:
             fh.write(data)

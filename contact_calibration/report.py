@@ -11,7 +11,6 @@ from __future__ import annotations
 import argparse
 import math
 import os
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Sequence
@@ -22,6 +21,7 @@ from clearance.contact_calibration.fit import GOALS, CalibrationResult, SpeedRow
 from clearance.mjcf.bearing import RingGeometry
 from clearance.model import Clearance
 from clearance.options import ModelOptions
+from clearance.results import atomic_write_bytes
 
 __all__ = ["ReportFiles", "accuracy_table", "calibration_report", "main_calibrate"]
 
@@ -60,18 +60,6 @@ def accuracy_table(rows: Sequence[SpeedRow]) -> str:
             + f" | {'met' if r.meets_goals() else 'missed'} |"
         )
     return head + "\n".join(lines) + "\n"
-
-
-def _atomic_write(path: Path, data: bytes) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "wb") as f:
-            f.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def _markdown(result: CalibrationResult, clearance: Clearance, ring: RingGeometry,
@@ -163,7 +151,7 @@ def calibration_report(
     speeds = np.asarray(plot_speeds if plot_speeds is not None else [sp[0], sp[len(sp) // 2], sp[-1]])
     md = out / f"{stem}.md"
     png = out / f"{stem}.png"
-    _atomic_write(md, _markdown(result, clearance, ring, options, title, source).encode())
+    atomic_write_bytes(md, _markdown(result, clearance, ring, options, title, source).encode())
     out.mkdir(parents=True, exist_ok=True)
     _plot(result, clearance, ring, options, speeds, png, exact_ln)
     return ReportFiles(md, png)

@@ -19,7 +19,6 @@ import hashlib
 import json
 import math
 import os
-import tempfile
 import warnings
 from pathlib import Path
 from typing import Any
@@ -37,6 +36,7 @@ from clearance.contact_calibration.fit import (
 from clearance.mjcf.bearing import RingGeometry
 from clearance.model import Clearance, Joint
 from clearance.options import ContactParameters, ModelOptions
+from clearance.results import atomic_write_bytes
 
 __all__ = [
     "CACHE_ENV",
@@ -161,16 +161,7 @@ def save_calibration(key: dict[str, Any], result: CalibrationResult, directory: 
     path = calibration_path(key, directory)
     path.parent.mkdir(parents=True, exist_ok=True)
     text = json.dumps({"key": key, "result": result.to_dict()}, indent=1, sort_keys=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.stem + ".", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8") as f:
-            f.write(text)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    atomic_write_bytes(path, text.encode("utf-8"))
     return path
 
 

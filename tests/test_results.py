@@ -42,3 +42,34 @@ def test_slicing_and_concatenation():
     joined = SimulationResult.concatenate([r.sliced(slice(0, 4)), r.sliced(slice(4, 10))])
     assert np.array_equal(joined.times, r.times)
     assert len(r.decimated(3)) == 4
+
+
+def test_output_files_get_the_usual_mode_of_a_new_file(tmp_path):
+    """Atomic writes end with 0o666 minus the umask (like open()), not mkstemp's private 0o600."""
+    import os
+    import stat
+
+    from clearance.contact_calibration.store import save_calibration
+    from clearance.results import atomic_write_text
+
+    old = os.umask(0o022)
+    try:
+        for mask in (0o022, 0o027):
+            os.umask(mask)
+            folder = tmp_path / f"umask{mask:o}"
+            atomic_write_text(folder / "summary.csv", "a,b\n")
+            atomic_write_text(folder / "summary.csv", "a,b,c\n")  # replacing a file too
+            npz, js = _result().save(folder / "run")
+            for p in (folder / "summary.csv", npz, js):
+                assert stat.S_IMODE(p.stat().st_mode) == 0o666 & ~mask, p.name
+        os.umask(0o022)
+
+        class _Result:  # save_calibration only needs to_dict()
+            def to_dict(self):
+                return {"parameters": None}
+
+        path = save_calibration({"k": 1}, _Result(), tmp_path / "cache")
+        assert stat.S_IMODE(path.stat().st_mode) == 0o644  # calibration files too
+    finally:
+        os.umask(old)
+    assert not list(tmp_path.rglob(".*tmp"))  # no temporary files left behind
