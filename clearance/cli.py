@@ -15,93 +15,16 @@ here, once.
 from __future__ import annotations
 
 import argparse
-import json
-import math
 import sys
 from pathlib import Path
 
 __all__ = ["main", "build_parser"]
 
 
-def _positive(kind: type, name: str):
-    def conv(text: str):
-        try:
-            v = kind(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
-        if not (math.isfinite(v) and v > 0):
-            raise argparse.ArgumentTypeError(f"{name} must be > 0 (got {text})")
-        return v
-
-    return conv
-
-
-def _add_scenario_args(p: argparse.ArgumentParser) -> None:
-    g = p.add_argument_group("scenario")
-    from clearance.builders import CATALOGUE
-
-    g.add_argument("--mechanism", default="slider_crank", choices=sorted(CATALOGUE), metavar="NAME",
-                   help="mechanism from the catalogue (default: slider_crank; one of: "
-                        + ", ".join(sorted(CATALOGUE)) + ")")
-    g.add_argument("--scenario", default=None, metavar="TOML",
-                   help="scenario file (a catalogue builder with overrides, or a whole mechanism); "
-                        "replaces --mechanism and the options below")
-    g.add_argument("--clearance-mm", type=_positive(float, "--clearance-mm"), default=None,
-                   help="radial clearance c [mm] (default: the builder's; 0.5 for the slider-crank)")
-    g.add_argument("--clearance-at", nargs="*", default=None, metavar="JOINT",
-                   help="joints with clearance (default: the builder's, rod_slider for the slider-crank); "
-                        "give none for the ideal mechanism")
-    g.add_argument("--rpm", type=_positive(float, "--rpm"), default=None,
-                   help="crank speed [rpm] (default: the builder's; 5000 for the slider-crank)")
-    g.add_argument("--gravity", action="store_true", help="gravity 9.81 m/s² along -y")
-    g = p.add_argument_group("numerics")
-    g.add_argument("--timestep-us", type=_positive(float, "--timestep-us"), default=1.0,
-                   help="time step [µs] (default 1)")
-    g.add_argument("--segments", type=int, default=None,
-                   help="bearing segment count N (default: chosen by the ripple rule)")
-    g.add_argument("--journal-geom", default="sphere", choices=["sphere", "capsule", "cylinder"])
-    g.add_argument("--segment-geom", default="sphere", choices=["sphere", "capsule", "box", "cylinder"])
-
-
-def _mechanism(args):
-    """The scenario's mechanism: a scenario file, or a catalogue builder with the options given."""
-    import inspect
-
-    from clearance.builders import CATALOGUE, load_scenario, rpm
-
-    if args.scenario:
-        given = [o for o, v in (("--clearance-mm", args.clearance_mm), ("--clearance-at", args.clearance_at),
-                                ("--rpm", args.rpm)) if v is not None]
-        if given:
-            raise ValueError(f"{', '.join(given)}: give these in the scenario file {args.scenario}, not with --scenario")
-        return load_scenario(args.scenario)
-    builder = CATALOGUE[args.mechanism].builder
-    accepted = inspect.signature(builder).parameters
-    kw = {}
-    if args.clearance_mm is not None:
-        kw["radial_clearance"] = args.clearance_mm * 1e-3
-    if args.clearance_at is not None:
-        kw["clearance_at"] = tuple(args.clearance_at)
-    if args.rpm is not None:
-        kw["crank_speed"] = rpm(args.rpm)
-    if args.gravity:
-        kw["gravity"] = 9.81
-    refused = [k for k in kw if k not in accepted]
-    if refused:
-        raise ValueError(f"mechanism '{args.mechanism}' does not take {refused} from the command line; "
-                         "use a scenario file (--scenario)")
-    return builder(**kw)
-
-
-def _options(args):
-    from clearance.options import ModelOptions
-
-    return ModelOptions(
-        segments=args.segments,
-        timestep=args.timestep_us * 1e-6,
-        journal_geom=args.journal_geom,
-        segment_geom=args.segment_geom,
-    )
+from clearance.cli_options import add_scenario_args as _add_scenario_args
+from clearance.cli_options import mechanism_from_args as _mechanism
+from clearance.cli_options import options_from_args as _options
+from clearance.cli_options import positive as _positive
 
 
 _FORWARDED = {
@@ -169,15 +92,15 @@ def _write_outputs(args, mech, result, ideal, out: Path) -> None:
 
     result.save(out / "result")
     ideal.save(out / "ideal")
+    period = min(d.period for d in mech.drives if d.kind.value != "torque")
+    # statistics skip the first drive period as start-up transient when the run is long enough
+    skip = period if result.times[-1] > 2 * period else 0.0
     if getattr(args, "rerun", None):
         from clearance.analysis.rerun_log import record
 
         print(f"  wrote {record(result, mech, args.rerun, ideal=ideal)}")
     rows = summarise(result, ideal)
     write_summary_csv(rows, out / "summary.csv")
-    period = min(d.period for d in mech.drives if d.kind.value != "torque")
-    # statistics skip the first drive period as start-up transient when the run is long enough
-    skip = period if result.times[-1] > 2 * period else 0.0
     write_report(out, result, ideal, skip=skip)
     output = mech.outputs[0].name
     angular = mech.outputs[0].kind.value == "angle"

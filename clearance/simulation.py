@@ -128,7 +128,9 @@ def simulate_prepared(
     nstep = int(round(duration / h))
     every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
     qpos0 = _initial_qpos(prepared, initial_eccentricity)
-    exact = prepared.options.contact_mode is ContactMode.EXACT_LN
+    # exact-LN mode imposes LN on clearance joints' rows; a model without any (the ideal
+    # twin) has nothing to impose and runs in the rollout
+    exact = prepared.options.contact_mode is ContactMode.EXACT_LN and bool(mech.clearance_joints)
     step = _exact_ln_stepper(prepared, qpos0) if exact else _rollout_stepper(prepared, qpos0)
     constant = _constant_controls(mech)
     bar = _progress(progress, nstep)

@@ -66,3 +66,21 @@ def test_catalogue_mechanism_and_scenario_file(tmp_path):
 def test_option_the_builder_lacks_is_refused(capsys):
     assert main(["mjcf", "--mechanism", "seven_bar_press", "--rpm", "100"]) == 2
     assert "does not take" in capsys.readouterr().err
+
+
+def test_run_contact_mode_option(tmp_path, capsys):
+    import json
+
+    out = tmp_path / "out"
+    # the default stays nominal; 0.3 ms covers the start of the first impact and stays fast
+    assert main(["run", "--duration-ms", "0.3", "--out", str(out), "--no-progress"]) == 0
+    meta = json.loads((out / "result.json").read_text())
+    assert meta["contact_mode"] == "nominal" and meta["contact"]["rod_slider"]["source"] == "nominal"
+    assert main(["run", "--contact-mode", "exact_ln", "--duration-ms", "0.3", "--out", str(out), "--no-progress"]) == 0
+    assert json.loads((out / "result.json").read_text())["contact_mode"] == "exact_ln"
+    capsys.readouterr()
+    with pytest.raises(SystemExit) as info:
+        main(["run", "--contact-mode", "ln"])
+    assert info.value.code == 2
+    assert "--contact-mode: invalid choice: 'ln'" in capsys.readouterr().err
+

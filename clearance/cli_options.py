@@ -1,0 +1,160 @@
+"""Command-line options that choose a scenario and its MuJoCo numerics.
+
+Shared by the commands that run a scenario (``clearance run``, ``mjcf``, ``reference``,
+``calibrate``) so they accept the same spellings and turn them into the same
+`Mechanism` and `ModelOptions`. Units are the ones people use (mm, rpm, µs); they are
+converted to SI here, once.
+"""
+
+from __future__ import annotations
+
+import argparse
+import inspect
+import math
+
+__all__ = [
+    "NUMERICS_FLAGS",
+    "positive",
+    "add_scenario_args",
+    "add_numerics_args",
+    "mechanism_from_args",
+    "options_from_args",
+    "numerics_given",
+]
+
+NUMERICS_FLAGS = {
+    "--timestep-us": "timestep_us",
+    "--segments": "segments",
+    "--journal-geom": "journal_geom",
+    "--segment-geom": "segment_geom",
+    "--contact-mode": "contact_mode",
+}
+"""MuJoCo-only options: flag -> argparse destination."""
+
+JOURNAL_GEOMS = ("sphere", "capsule", "cylinder")
+SEGMENT_GEOMS = ("sphere", "capsule", "box", "cylinder")
+CONTACT_MODES = ("nominal", "calibrated", "exact_ln")
+
+
+def positive(kind: type, name: str):
+    """An argparse ``type`` accepting finite numbers > 0 of ``kind`` (int or float)."""
+
+    def conv(text: str):
+        try:
+            v = kind(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+        if not (math.isfinite(v) and v > 0):
+            raise argparse.ArgumentTypeError(f"{name} must be > 0 (got {text})")
+        return v
+
+    return conv
+
+
+def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, contact_mode: bool = True) -> None:
+    """Add the scenario options (and, with ``numerics``, the MuJoCo numerics) to a parser.
+
+    Args:
+        p: the parser.
+        numerics: offer the MuJoCo numerics group (`add_numerics_args`). Without it the
+            numerics flags are still parsed, hidden, so that a command can refuse them
+            with its own explanation (`numerics_given`).
+        contact_mode: offer ``--contact-mode`` in the numerics group.
+    """
+    g = p.add_argument_group("scenario")
+    from clearance.builders import CATALOGUE
+
+    g.add_argument("--mechanism", default="slider_crank", choices=sorted(CATALOGUE), metavar="NAME",
+                   help="mechanism from the catalogue (default: slider_crank; one of: "
+                        + ", ".join(sorted(CATALOGUE)) + ")")
+    g.add_argument("--scenario", default=None, metavar="TOML",
+                   help="scenario file (a catalogue builder with overrides, or a whole mechanism); "
+                        "replaces --mechanism and the options below")
+    g.add_argument("--clearance-mm", type=positive(float, "--clearance-mm"), default=None,
+                   help="radial clearance c [mm] (default: the builder's; 0.5 for the slider-crank)")
+    g.add_argument("--clearance-at", nargs="*", default=None, metavar="JOINT",
+                   help="joints with clearance (default: the builder's, rod_slider for the slider-crank); "
+                        "give none for the ideal mechanism")
+    g.add_argument("--rpm", type=positive(float, "--rpm"), default=None,
+                   help="crank speed [rpm] (default: the builder's; 5000 for the slider-crank)")
+    g.add_argument("--gravity", action="store_true", help="gravity 9.81 m/s² along -y")
+    if numerics:
+        add_numerics_args(p, contact_mode=contact_mode)
+    else:
+        for flag, dest in NUMERICS_FLAGS.items():
+            p.add_argument(flag, dest=dest, default=None, help=argparse.SUPPRESS)
+
+
+def add_numerics_args(p: argparse.ArgumentParser, *, contact_mode: bool = True) -> None:
+    """Add the MuJoCo numerics group: time step, segments, geoms and (optionally) contact mode."""
+    g = p.add_argument_group("numerics")
+    g.add_argument("--timestep-us", type=positive(float, "--timestep-us"), default=1.0,
+                   help="time step [µs] (default 1)")
+    g.add_argument("--segments", type=int, default=None,
+                   help="bearing segment count N (default: chosen by the ripple rule)")
+    g.add_argument("--journal-geom", default="sphere", choices=JOURNAL_GEOMS,
+                   help="journal geom (default sphere)")
+    g.add_argument("--segment-geom", default="sphere", choices=SEGMENT_GEOMS,
+                   help="bearing segment geom (default sphere)")
+    if contact_mode:
+        g.add_argument("--contact-mode", default="nominal", choices=CONTACT_MODES,
+                       help="contact parameters: nominal (formulas, default), calibrated (fitted to LN "
+                            "impacts once, then reused from the cache; see 'clearance calibrate') or "
+                            "exact_ln (the LN force imposed every step; slower, frictionless joints only)")
+
+
+def numerics_given(args: argparse.Namespace) -> list[str]:
+    """The MuJoCo numerics flags given on the command line of a command that hides them."""
+    return [flag for flag, dest in NUMERICS_FLAGS.items() if getattr(args, dest, None) is not None]
+
+
+def mechanism_from_args(args: argparse.Namespace):
+    """The scenario's `Mechanism`: a scenario file, or a catalogue builder with the options given.
+
+    Raises:
+        ValueError: an option given with ``--scenario``, or one the builder does not take.
+        ScenarioError, AssemblyError: a bad scenario (both are ValueErrors).
+    """
+    from clearance.builders import CATALOGUE, load_scenario, rpm
+
+    if args.scenario:
+        given = [o for o, v in (("--clearance-mm", args.clearance_mm), ("--clearance-at", args.clearance_at),
+                                ("--rpm", args.rpm)) if v is not None]
+        if args.gravity:
+            given.append("--gravity")
+        if given:
+            raise ValueError(f"{', '.join(given)}: give these in the scenario file {args.scenario}, not with --scenario")
+        return load_scenario(args.scenario)
+    builder = CATALOGUE[args.mechanism].builder
+    accepted = inspect.signature(builder).parameters
+    kw = {}
+    if args.clearance_mm is not None:
+        kw["radial_clearance"] = args.clearance_mm * 1e-3
+    if args.clearance_at is not None:
+        kw["clearance_at"] = tuple(args.clearance_at)
+    if args.rpm is not None:
+        kw["crank_speed"] = rpm(args.rpm)
+    if args.gravity:
+        kw["gravity"] = 9.81
+    refused = [k for k in kw if k not in accepted]
+    if refused:
+        raise ValueError(f"mechanism '{args.mechanism}' does not take {refused} from the command line; "
+                         "use a scenario file (--scenario)")
+    return builder(**kw)
+
+
+def options_from_args(args: argparse.Namespace):
+    """`ModelOptions` from the numerics group (SI: the time step in seconds).
+
+    Raises:
+        ValueError: a value `ModelOptions` rejects (it names the field).
+    """
+    from clearance.options import ModelOptions
+
+    return ModelOptions(
+        segments=args.segments,
+        timestep=args.timestep_us * 1e-6,
+        journal_geom=args.journal_geom,
+        segment_geom=args.segment_geom,
+        contact_mode=getattr(args, "contact_mode", None) or "nominal",
+    )
