@@ -76,6 +76,7 @@ _LAZY = {
     "load_calibration": "store",
     "save_calibration": "store",
     "calibrate": "store",
+    "calibrate_joint": "store",
     "calibrated_parameters": "store",
     # exact LN
     "ExactLNContact": "exact_ln",

@@ -158,61 +158,71 @@ def calibration_report(
 
 
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="clearance calibrate",
-                                description="Fit the MuJoCo contact of every clearance joint to LN impacts.")
-    p.add_argument("--clearance-mm", type=float, default=0.5, help="radial clearance c [mm] (default 0.5)")
-    p.add_argument("--rpm", type=float, default=5000.0, help="crank speed [rpm] (default 5000)")
-    p.add_argument("--timestep-us", type=float, default=1.0, help="time step [µs] (default 1)")
-    p.add_argument("--segments", type=int, default=None, help="segment count N (default: ripple rule)")
-    p.add_argument("--journal-geom", default="sphere", choices=["sphere", "capsule", "cylinder"])
-    p.add_argument("--segment-geom", default="sphere", choices=["sphere", "capsule", "box", "cylinder"])
-    p.add_argument("--speeds", type=float, nargs=2, metavar=("LO", "HI"), default=None,
-                   help="impact speed range [m/s] (default: impact speed / 50 to impact speed)")
-    p.add_argument("--n-speeds", type=int, default=8, help="fit speeds (default 8)")
-    p.add_argument("--cycle-mass", action="store_true",
-                   help="effective mass: median over the ideal cycle (drive locked) instead of qpos0")
-    p.add_argument("--no-cache", action="store_true", help="refit even if a calibration file exists")
+    from clearance.cli_options import add_scenario_args, positive
+
+    p = argparse.ArgumentParser(
+        prog="clearance calibrate",
+        description="Fit the MuJoCo contact of every clearance joint of a scenario to LN impacts, at the "
+                    "sizing 'clearance run' uses (effective mass: median over the ideal cycle, with its "
+                    "min-max range; fit speeds: impact speed / 50 to impact speed). The calibration file "
+                    "is what 'clearance run --contact-mode calibrated' then reuses for the same scenario "
+                    "and numerics.")
+    add_scenario_args(p, contact_mode=False)
+    g = p.add_argument_group("fit")
+    g.add_argument("--speeds", type=positive(float, "--speeds"), nargs=2, metavar=("LO", "HI"), default=None,
+                   help="fit over LO..HI [m/s] instead of the default range; such a fit is stored on its "
+                        "own and is not the one 'clearance run --contact-mode calibrated' reuses")
+    g.add_argument("--n-speeds", type=positive(int, "--n-speeds"), default=None,
+                   help="number of log-spaced speeds between LO and HI (with --speeds only; default 8)")
+    g.add_argument("--no-cache", action="store_true", help="refit even if a calibration file exists")
     p.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
     return p
 
 
 def main_calibrate(argv: Sequence[str] | None = None) -> int:
-    """``clearance calibrate``: calibrate every clearance joint of the slider-crank scenario.
+    """``clearance calibrate``: calibrate every clearance joint of a scenario.
 
-    Writes ``calibration_<joint>.md`` and ``.png`` in ``--out`` and prints the table.
+    Takes the scenario and numerics options of ``clearance run`` and sizes each joint as
+    `clearance.preparation.prepare` does, so that the calibration file written is the one
+    a run in ``contact_mode="calibrated"`` reads. Writes ``calibration_<joint>.md`` and
+    ``.png`` in ``--out`` and prints the table.
 
     Returns:
         0 on success, 2 on bad input or an unstable calibration.
     """
-    from clearance.builders import rpm, slider_crank
-    from clearance.contact_calibration.effective_mass import cycle_effective_mass
+    import sys
+
+    from clearance.cli_options import mechanism_from_args, options_from_args
     from clearance.contact_calibration.fit import CalibrationStabilityError
-    from clearance.contact_calibration.store import calibrate
+    from clearance.contact_calibration.store import calibrate_joint
     from clearance.preparation import prepare
 
-    args = _parser().parse_args(argv)
+    p = _parser()
+    args = p.parse_args(argv)
+    if args.speeds is not None and not args.speeds[0] < args.speeds[1]:
+        p.error(f"--speeds: LO must be below HI (got {args.speeds[0]:g} {args.speeds[1]:g} m/s)")
+    if args.n_speeds is not None and args.speeds is None:
+        p.error("--n-speeds needs --speeds LO HI (the default fit uses 8 speeds from impact speed / 50 "
+                "to impact speed, the ones a calibrated run reuses)")
+    if args.n_speeds is not None and args.n_speeds < 2:
+        p.error(f"--n-speeds must be at least 2 (got {args.n_speeds})")
     try:
-        mech = slider_crank(crank_speed=rpm(args.rpm), radial_clearance=args.clearance_mm * 1e-3)
-        options = ModelOptions(segments=args.segments, timestep=args.timestep_us * 1e-6,
-                               journal_geom=args.journal_geom, segment_geom=args.segment_geom)
+        mech = mechanism_from_args(args)
+        if not mech.clearance_joints:
+            raise ValueError(f"mechanism '{mech.name}' has no clearance joint to calibrate (see --clearance-at)")
+        options = options_from_args(args)
         prep = prepare(mech, options)
-        masses = cycle_effective_mass(prep.model, prep.built, mech) if args.cycle_mass else {}
+        speeds = np.geomspace(args.speeds[0], args.speeds[1], args.n_speeds or 8) if args.speeds else None
         for j in mech.clearance_joints:
-            s, ring = prep.sizing[j.name], prep.built.rings[j.name]
-            em = masses.get(j.name)
-            mass = em.median if em else s.effective_mass
-            speeds = (np.geomspace(args.speeds[0], args.speeds[1], args.n_speeds)
-                      if args.speeds else None)
-            result, path = calibrate(
-                j.clearance, ring, options, mass=mass, impact_speed=s.impact_speed, speeds=speeds,
-                mass_range=em.valid_range if em else None, max_penetration=s.penetration_limit,
-                use_cache=not args.no_cache)
+            ring = prep.built.rings[j.name]
+            result, path = calibrate_joint(j, ring, prep.sizing[j.name], options, speeds=speeds,
+                                           use_cache=not args.no_cache)
             files = calibration_report(result, j.clearance, ring, options, out_dir=args.out,
                                        stem=f"calibration_{j.name}", title=f"Contact calibration: {j.name}",
                                        source=str(path) if path else None)
             print(files.markdown.read_text())
             print(f"wrote {files.markdown} and {files.plot}")
     except (ValueError, CalibrationStabilityError) as exc:
-        print(f"clearance calibrate: error: {exc}")
+        print(f"clearance calibrate: error: {exc}", file=sys.stderr)
         return 2
     return 0

@@ -47,6 +47,7 @@ __all__ = [
     "load_calibration",
     "save_calibration",
     "calibrate",
+    "calibrate_joint",
     "calibrated_parameters",
 ]
 
@@ -212,16 +213,55 @@ def calibrate(
     return result, (save_calibration(key, result) if use_cache else None)
 
 
-def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Any, options: ModelOptions) -> ContactParameters:
-    """Calibrated per-row contact parameters of a clearance joint (cached).
+def calibrate_joint(
+    joint: Joint, ring: RingGeometry, sizing: Any, options: ModelOptions, *,
+    speeds: np.ndarray | None = None, use_cache: bool = True,
+) -> tuple[CalibrationResult, Path | None]:
+    """Calibrate a clearance joint of a prepared model at its own sizing (cached).
 
-    The entry point of `ContactMode.CALIBRATED` in `clearance.preparation`.
+    The one place that turns a joint's sizing into calibration inputs, so that
+    ``clearance calibrate`` writes the file `ContactMode.CALIBRATED` later reads: the
+    effective mass is the cycle median with its (min, max) range, the fit speeds span
+    impact_speed / 50 to impact_speed (`default_speeds`) unless ``speeds`` is given.
 
     Args:
         joint: the clearance joint.
         ring: its ring geometry.
-        sizing: its `JointSizing` (effective_mass [kg], impact_speed [m/s],
-            penetration_limit [m] are used).
+        sizing: its `JointSizing` (effective_mass [kg], effective_mass_range [kg],
+            impact_speed [m/s], penetration_limit [m] are used).
+        options: model options.
+        speeds: fit speeds [m/s] instead of the default range (such a fit is stored
+            under its own key, not the one a run reuses).
+        use_cache: read and write the cache.
+
+    Returns:
+        The calibration and its file (None without cache).
+
+    Raises:
+        ValueError: a joint without clearance, or bad arguments.
+        CalibrationStabilityError: the fitted contact is unstable at the time step.
+    """
+    if joint.clearance is None:
+        raise ValueError(f"joint '{joint.name}' has no clearance to calibrate")
+    mrange = getattr(sizing, "effective_mass_range", None)
+    return calibrate(joint.clearance, ring, options, mass=float(sizing.effective_mass),
+                     impact_speed=float(sizing.impact_speed), speeds=speeds,
+                     mass_range=tuple(mrange) if mrange else None,
+                     max_penetration=float(sizing.penetration_limit), use_cache=use_cache)
+
+
+def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Any, options: ModelOptions) -> ContactParameters:
+    """Calibrated per-row contact parameters of a clearance joint (cached).
+
+    The entry point of `ContactMode.CALIBRATED` in `clearance.preparation`; it reuses the
+    file ``clearance calibrate`` writes for the same scenario and numerics
+    (`calibrate_joint`).
+
+    Args:
+        joint: the clearance joint.
+        ring: its ring geometry.
+        sizing: its `JointSizing` (effective_mass [kg], effective_mass_range [kg],
+            impact_speed [m/s], penetration_limit [m] are used).
         options: model options.
 
     Returns:
@@ -230,12 +270,6 @@ def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Any, options
     Raises:
         CalibrationStabilityError: the fitted contact is unstable at the time step.
     """
-    if joint.clearance is None:
-        raise ValueError(f"joint '{joint.name}' has no clearance to calibrate")
-    mass = float(sizing.effective_mass)
-    mrange = getattr(sizing, "effective_mass_range", None)
-    result, path = calibrate(joint.clearance, ring, options, mass=mass,
-                             impact_speed=float(sizing.impact_speed), mass_range=mrange,
-                             max_penetration=float(sizing.penetration_limit))
+    result, path = calibrate_joint(joint, ring, sizing, options)
     p = result.parameters
     return ContactParameters(p.stiffness, p.damping, f"calibrated: {path}")

@@ -84,3 +84,38 @@ def test_run_contact_mode_option(tmp_path, capsys):
     assert info.value.code == 2
     assert "--contact-mode: invalid choice: 'ln'" in capsys.readouterr().err
 
+
+def test_calibrate_writes_the_calibration_a_calibrated_run_reuses(tmp_path, monkeypatch, capsys):
+    """`clearance calibrate` sizes like `prepare`: the run and `prepare` read its file, no refit."""
+    import json
+
+    from clearance.builders import slider_crank
+    from clearance.contact_calibration import cache_dir, store
+    from clearance.options import ModelOptions
+    from clearance.preparation import prepare
+
+    fits = []
+    real_fit = store.fit_contact
+
+    def counting_fit(*args, **kwargs):
+        fits.append(kwargs["mass_range"])
+        return real_fit(*args, **kwargs)
+
+    monkeypatch.setattr(store, "fit_contact", counting_fit)
+    assert main(["calibrate", "--out", str(tmp_path / "cal")]) == 0
+    assert "Contact calibration: rod_slider" in capsys.readouterr().out
+    files = list(cache_dir().glob("calib-*.json"))
+    assert len(fits) == 1 and len(files) == 1
+    prepared = prepare(slider_crank(), ModelOptions(contact_mode="calibrated"))
+    assert len(fits) == 1, "prepare refitted instead of reading the file clearance calibrate wrote"
+    assert prepared.contact["rod_slider"].source == f"calibrated: {files[0]}"
+    # keyed with the cycle's (min, max) effective mass, as prepare sizes it (not (m, m))
+    key = json.loads(files[0].read_text())["key"]
+    assert key["mass_range"] == list(prepared.sizing["rod_slider"].effective_mass_range)
+    assert key["mass_range"][0] < key["mass_range"][1]
+    out = tmp_path / "run"
+    assert main(["run", "--contact-mode", "calibrated", "--duration-ms", "0.3", "--out", str(out), "--no-progress"]) == 0
+    assert len(fits) == 1, "clearance run --contact-mode calibrated refitted"
+    meta = json.loads((out / "result.json").read_text())
+    assert meta["contact"]["rod_slider"]["source"] == f"calibrated: {files[0]}"
+
