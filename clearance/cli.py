@@ -23,6 +23,7 @@ __all__ = ["main", "build_parser"]
 
 from clearance.cli_options import add_scenario_args as _add_scenario_args
 from clearance.cli_options import mechanism_from_args as _mechanism
+from clearance.cli_options import numerics_given as _numerics_given
 from clearance.cli_options import options_from_args as _options
 from clearance.cli_options import positive as _positive
 
@@ -54,7 +55,7 @@ def build_parser() -> argparse.ArgumentParser:
     r.add_argument("--rerun", default=None, metavar="PATH",
                    help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH")
     f = sub.add_parser("reference", help="run a scenario with the exact-geometry reference solver (slow)")
-    _add_scenario_args(f)
+    _add_scenario_args(f, numerics=False)  # MuJoCo numerics are refused (see _cmd_reference)
     f.add_argument("--revolutions", type=_positive(float, "--revolutions"), default=1.0,
                    help="crank revolutions to simulate (default 1)")
     f.add_argument("--duration-ms", type=_positive(float, "--duration-ms"), default=None,
@@ -105,6 +106,10 @@ def _write_outputs(args, mech, result, ideal, out: Path) -> None:
     output = mech.outputs[0].name
     angular = mech.outputs[0].kind.value == "angle"
     for r in rows:
+        if not r.max_penetration > 0:  # penetration = |e| - c never above 0: the journal never touched
+            print(f"  {r.joint}: no contact (the journal stayed at least {-r.max_penetration * 1e6:.3g} µm "
+                  "from the bearing)")
+            continue
         print(f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
               f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
               f"max penetration {r.max_penetration * 1e6:.3g} µm")
@@ -156,6 +161,14 @@ def _cmd_run(args) -> int:
 def _cmd_reference(args) -> int:
     from clearance.reference import ReferenceSolverError, run_reference
 
+    given = _numerics_given(args)
+    if given:
+        raise ValueError(
+            f"clearance reference does not take {', '.join(given)}: those are MuJoCo options, and the "
+            "reference solver has exact circle-in-circle geometry (no segments or geoms), applies each "
+            "joint's contact law exactly (no contact mode) and takes adaptive steps (no time step); "
+            "set its accuracy with --rtol and its output interval with --output-us"
+        )
     mech = _mechanism(args)
     duration = _duration(args, mech)
     out = Path(args.out)

@@ -119,3 +119,19 @@ def test_calibrate_writes_the_calibration_a_calibrated_run_reuses(tmp_path, monk
     meta = json.loads((out / "result.json").read_text())
     assert meta["contact"]["rod_slider"]["source"] == f"calibrated: {files[0]}"
 
+
+@pytest.mark.parametrize("flag,value", [("--segments", "36"), ("--timestep-us", "2"), ("--journal-geom", "capsule"),
+                                        ("--segment-geom", "box"), ("--contact-mode", "calibrated")])
+def test_reference_refuses_mujoco_numerics(flag, value, tmp_path, capsys):
+    assert main(["reference", flag, value, "--duration-ms", "0.1", "--out", str(tmp_path), "--no-progress"]) == 2
+    err = capsys.readouterr().err
+    assert f"clearance reference does not take {flag}" in err
+    assert "exact circle-in-circle geometry" in err and "adaptive steps" in err
+    assert not list(tmp_path.iterdir())  # refused before any work
+
+
+def test_joint_that_never_touched_prints_no_contact(tmp_path, capsys):
+    # 0.1 ms ends before the first impact (about 0.25 ms, REFERENCES.md section 6)
+    assert main(["reference", "--duration-ms", "0.1", "--out", str(tmp_path), "--no-progress"]) == 0
+    out = capsys.readouterr().out
+    assert "rod_slider: no contact" in out and "max penetration" not in out
