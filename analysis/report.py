@@ -19,13 +19,35 @@ from clearance.analysis.response import compare_response, contact_modes
 from clearance.analysis.statistics import deviation_statistics, drive_period
 from clearance.results import SimulationResult, atomic_write_text
 
-__all__ = ["write_report"]
+__all__ = ["write_report", "joint_sections"]
 
 
 def _clearance_of(result: SimulationResult, joint: str) -> float:
     """Radial clearance c [m] from the samples: |e| - penetration = c at every sample."""
     jr = result.joints[joint]
     return float(np.median(np.hypot(jr.eccentricity[:, 0], jr.eccentricity[:, 1]) - jr.penetration))
+
+
+def _section(result: SimulationResult, names: list[str], period: float, skip: float) -> np.ndarray:
+    """(K, len(names)) Poincaré points at t = kT of the drive, from ``skip`` after the start on."""
+    ts, pts = poincare_from_result(result, names, period=period)
+    return pts[ts >= result.times[0] + skip]
+
+
+def joint_sections(result: SimulationResult, *, skip: float | None = None) -> dict[str, np.ndarray]:
+    """Each clearance joint's Poincaré section, as `write_report` computes and draws it.
+
+    Args:
+        result: a run.
+        skip: start-up transient [s]; default one drive period.
+
+    Returns:
+        joint name -> (K, 2) journal-centre eccentricity [m] in the bearing frame, sampled at
+        t = kT of the drive (T the drive period) from ``skip`` on; K may be 0.
+    """
+    period = drive_period(result)
+    skip = period if skip is None else skip
+    return {j: _section(result, [f"{j}.ex", f"{j}.ey"], period, skip) for j in result.joints}
 
 
 def _g(v: float) -> str:
@@ -126,9 +148,7 @@ def write_report(
     sections = [(output, f"{output}_vel")] + [(f"{j}.ex", f"{j}.ey") for j in result.joints]
     lines += ["| section | points | regime | period | divergence | correlation dim. |", "|---|---:|---|---:|---:|---:|"]
     for k, names in enumerate(sections):
-        ts, pts = poincare_from_result(result, list(names), period=period)
-        keep = ts >= result.times[0] + skip
-        pts = pts[keep]
+        pts = _section(result, list(names), period, skip)
         if len(pts) == 0:
             continue
         after = result.times >= result.times[0] + skip

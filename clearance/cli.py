@@ -98,8 +98,11 @@ def _write_outputs(args, mech, result, ideal, out: Path) -> None:
     skip = period if result.times[-1] > 2 * period else 0.0
     if getattr(args, "rerun", None):
         from clearance.analysis.rerun_log import record
+        from clearance.analysis.report import joint_sections
 
-        print(f"  wrote {record(result, mech, args.rerun, ideal=ideal)}")
+        # the report's Poincaré sections (t = kT of the drive, after the same transient)
+        sections = joint_sections(result, skip=skip)
+        print(f"  wrote {record(result, mech, args.rerun, ideal=ideal, poincare=sections)}")
     rows = summarise(result, ideal)
     write_summary_csv(rows, out / "summary.csv")
     write_report(out, result, ideal, skip=skip)

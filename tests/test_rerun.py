@@ -224,6 +224,10 @@ def test_bad_arguments_fail_before_writing(runs, tmp_path):
 
 
 def test_cli_run_writes_a_recording(tmp_path):
+    import os
+    import stat
+
+    from clearance.analysis.chaos import poincare_from_result
     from clearance.cli import main
 
     rrd = tmp_path / "run.rrd"
@@ -231,6 +235,38 @@ def test_cli_run_writes_a_recording(tmp_path):
     data, blueprints = _read(rrd)
     assert ("/joints/rod_slider/orbit", False) in data and ("/outputs/slider_x/displacement/ideal", False) in data
     assert blueprints
+    # the report's Poincaré section: eccentricity at t = kT of the drive (a 0.3 ms run of a
+    # 12 ms period, too short to skip a transient, has its one point at t = 0)
+    res = SimulationResult.load(tmp_path / "out" / "result.npz")
+    ts, expected = poincare_from_result(res, ["rod_slider.ex", "rod_slider.ey"])
+    assert np.array_equal(ts, [0.0])
+    pp = np.asarray(data[("/joints/rod_slider/poincare", True)]["Points2D:positions"][0], float)
+    np.testing.assert_allclose(pp, expected * 1e6, rtol=F32_RTOL, atol=0)
+    mask = os.umask(0)
+    os.umask(mask)
+    assert stat.S_IMODE(rrd.stat().st_mode) == 0o666 & ~mask  # a normal output file, not private
+
+
+def test_orbit_points_are_coloured_by_force(runs, tmp_path):
+    mech, res = runs["one"]
+    path = rerun_log.record(res, mech, tmp_path / "run.rrd")
+    data, _ = _read(path)
+    colors = _squeeze(data[("/joints/rod_slider/orbit", False)]["Points2D:colors"]).astype(np.uint32)
+    f = res.joints["rod_slider"].force_magnitude
+    assert np.array_equal(colors, rerun_log._force_colors(f, f.max()))  # packed RGBA: exact
+    # independently of that function: grey without contact, viridis' top colour at the peak force
+    assert np.all(colors[f == 0] == 0x9A9A9AFF) and 0 < np.sum(f > 0) < len(f)
+    assert colors[np.argmax(f)] == 0xFDE725FF
+
+
+def test_importing_the_simulation_does_not_load_rerun():
+    """rerun is only imported for a recording: simulations and the reference solver do without it."""
+    import subprocess
+    import sys
+
+    code = ("import sys; import clearance; from clearance import simulate; import clearance.reference; "
+            "sys.exit('rerun' in sys.modules)")
+    assert subprocess.run([sys.executable, "-c", code]).returncode == 0
 
 
 def test_reference_solver_run_records_like_a_mujoco_run(runs, tmp_path):
