@@ -35,7 +35,7 @@ import tomli_w
 
 from clearance.builders._scenario_builder import from_builder
 from clearance.builders._toml_reader import Locator, ScenarioError, Table
-from clearance.kinematics import AssemblyError, assemble
+from clearance.kinematics import AssemblyError, SingularPositionError, assemble
 from clearance.model import (
     Clearance,
     ContactLaw,
@@ -90,7 +90,13 @@ def loads_scenario(text: str, *, source: str = "<string>") -> Mechanism:
     mechanism = _read_full(top, mech)
     try:
         assemble(mechanism)
+    except SingularPositionError as e:
+        raise ScenarioError(f"the mechanism starts in a singular position at t = 0: {e}", path=source) from None
     except AssemblyError as e:
+        # name the [[joints]] entry (and its line) whose two sides stay farthest apart
+        tables = [t for t in top.array("joints") if t.raw("name") == e.joint]
+        if tables:
+            raise tables[0].error(None, f"the loops cannot be closed at t = 0: {e}") from None
         raise ScenarioError(f"the loops cannot be closed at t = 0: {e}", path=source) from None
     return mechanism
 

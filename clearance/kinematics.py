@@ -29,7 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from clearance.constraints import ConstraintSystem, _Pair, _rot  # noqa: F401 (re-exported)
-from clearance.model import Mechanism, OutputKind
+from clearance.model import JointType, Mechanism, OutputKind
 
 __all__ = [
     "AssemblyError",
@@ -52,7 +52,19 @@ SINGULAR_TOL = 1e-7
 
 
 class AssemblyError(ValueError):
-    """The mechanism cannot be assembled (non-closable loop or singular position)."""
+    """The mechanism cannot be assembled (non-closable loop or singular position).
+
+    Attributes:
+        joint: where the loops cannot be closed, the joint with the largest closure
+            residual at the last Newton iterate (None when not known).
+        gap: that joint's residual: how far apart its two sides stay [m] (None when not
+            known).
+    """
+
+    def __init__(self, message: str, *, joint: str | None = None, gap: float | None = None) -> None:
+        super().__init__(message)
+        self.joint = joint
+        self.gap = gap
 
 
 class SingularPositionError(AssemblyError):
@@ -95,7 +107,26 @@ def _newton(
         # damp very large rotation steps so Newton stays on the nearby branch
         big = float(np.max(np.abs(step[2::3]))) if cs.n_links else 0.0
         q = q + min(1.0, 0.5 / max(1e-300, big)) * step
-    return q, res, False
+    f = cs.phi(q, t)
+    return q, float(np.max(np.abs(f))) if f.size else 0.0, False
+
+
+def _widest_gap(cs: ConstraintSystem, q: np.ndarray, t: float) -> tuple[str | None, float]:
+    """(joint, residual [m]) of the pair whose closure residual at q is largest.
+
+    A revolute pair's residual is its pin gap; a prismatic pair's its offset normal to the
+    axis with the angle error times the length scale.
+    """
+    f = cs.phi(q, t)
+    best, gap = None, -1.0
+    for k, (name, pair) in enumerate(zip(cs.pair_names, cs.pairs)):
+        a, b = f[2 * k], f[2 * k + 1]
+        if pair.kind is not JointType.REVOLUTE:
+            a = a * cs.length_scale
+        g = float(np.hypot(a, b))
+        if g > gap:
+            best, gap = name, g
+    return best, max(gap, 0.0)
 
 
 def _check_square(cs: ConstraintSystem) -> None:
@@ -152,10 +183,14 @@ def assemble(
     )
     q, res, ok = _newton(cs, q0, t, tol, max_iter)
     if not ok:
+        joint, gap = _widest_gap(cs, q, t)
+        where = (f"; the largest is at joint '{joint}', whose two sides stay {gap:.3g} m apart"
+                 if joint is not None else "")
         raise AssemblyError(
             f"mechanism '{mechanism.name}' cannot be assembled at t = {t:g} s: loop-closure "
-            f"residual {res:.3g} after {max_iter} Newton iterations (check that the link "
-            "lengths can close every loop at the drive start angles, and the pose guesses)"
+            f"residual {res:.3g} after {max_iter} Newton iterations{where} (check that the link "
+            "lengths can close every loop at the drive start angles, and the pose guesses)",
+            joint=joint, gap=gap if joint is not None else None,
         )
     measure = float(cs.singularity_measure(q))
     if measure < singular_tol:

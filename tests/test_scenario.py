@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 from importlib import resources
 
 import pytest
@@ -69,7 +70,8 @@ MALFORMED = [
     ("missing joint", ('joint = "O2"', 'joint = "O9"'), r"line \d+: \[\[drives\]\] #1 'crank': key 'joint': unknown joint 'O9'"),
     ("bad unit", ("mass_kg = 0.2041", "mass_lb = 0.2041"), r"line \d+: \[\[links\]\] #3 'coupler3': key 'mass_lb': bad unit 'lb'"),
     ("no unit", ("mass_kg = 0.2041", "mass = 0.2041"), r"key 'mass': needs a unit in its name \(mass is a mass: use mass_kg"),
-    ("unclosable loop", ("O4 = [0.13, 0.0]", "O4 = [0.5, 0.0]"), r"the loops cannot be closed at t = 0"),
+    ("unclosable loop", ("O4 = [0.13, 0.0]", "O4 = [0.5, 0.0]"),
+     r"line \d+: \[\[joints\]\] #3 'B': the loops cannot be closed at t = 0: .* the largest is at joint 'B'"),
     ("unknown key", ('kind = "revolute"', 'kind = "revolute"\nclearence = 1'), r"key 'clearence': unknown key; expected one of"),
     ("missing key", ('name = "A"\n', ""), r"line \d+: \[\[joints\]\] #2: missing key 'name'"),
     ("bad choice", ('kind = "revolute"', 'kind = "hinge"'), r"key 'kind': must be one of \['revolute', 'prismatic'\]"),
@@ -87,6 +89,21 @@ def test_malformed_full_scenarios_name_the_key(case, edit, pattern):
     with pytest.raises(ScenarioError, match=pattern) as err:
         loads_scenario(BASE.replace(old, new, 1), source="bad.toml")
     assert str(err.value).startswith("bad.toml")
+
+
+def test_unclosable_loop_names_the_joint_entry_and_its_line():
+    text = BASE.replace("O4 = [0.13, 0.0]", "O4 = [0.5, 0.0]", 1)  # ground 0.5 m: longer than the other three
+    with pytest.raises(ScenarioError) as info:
+        loads_scenario(text, source="bad.toml")
+    err = info.value
+    lines = text.splitlines()
+    # the [[joints]] header of B: the joint whose two sides Newton leaves farthest apart
+    header = next(i for i, ln in enumerate(lines) if ln == "[[joints]]" and lines[i + 1] == 'name = "B"') + 1
+    assert err.key == "joints.2" and err.line == header
+    # its gap is the residual quoted; the loop is 0.5 - (0.04 + 0.13 + 0.1) = 0.23 m short, and
+    # Newton ends with about that gap at B (0.249 m measured): between 0.1 and 0.5 m
+    gap = float(re.search(r"two sides stay ([0-9.e+-]+) m apart", str(err)).group(1))
+    assert 0.1 < gap < 0.5
 
 
 BUILDER_CASES = [
