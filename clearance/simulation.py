@@ -2,8 +2,9 @@
 
 The run is stepped in chunks (bounded memory); after each chunk MuJoCo's warning counters,
 non-finite values and every journal's penetration are checked. A run that goes unstable
-stops with `SimulationError`, which names the time, the joint and a remedy, and carries the
-result computed up to the last good step.
+stops with `SimulationError`, which names the time, the joint (when a journal went beyond
+its bound; None when the cause is the model's state as a whole) and a remedy, and carries
+the result computed up to the last good step: the rows before the first bad one.
 """
 
 from __future__ import annotations
@@ -24,7 +25,14 @@ __all__ = ["SimulationError", "simulate", "simulate_prepared", "default_duration
 
 
 class SimulationError(RuntimeError):
-    """A run diverged. ``partial`` holds the result up to the last good step (or None)."""
+    """A run diverged.
+
+    Attributes:
+        partial: the result up to the last good step (None when there is none).
+        time: time of the first bad step [s].
+        joint: the clearance joint whose journal went beyond its divergence bound, or None
+            when the cause cannot be tied to one joint (a non-finite state, a MuJoCo warning).
+    """
 
     def __init__(self, message: str, partial=None, *, time: float | None = None, joint: str | None = None):
         super().__init__(message)
@@ -141,15 +149,17 @@ def simulate_prepared(
         n = min(chunk_steps, nstep - done)
         times = (done + np.arange(n)) * h
         ctrl = _controls(mech, times[:1] if constant else times)
+        failure = None
         try:
             states, sens, data = step(ctrl, n)
         except _StepFailure as fail:
-            states, sens, data = fail.states, fail.sens, fail.data
+            states, sens, data, failure = fail.states, fail.sens, fail.data, fail.reason
         part = read_sensors(prepared, times[: len(sens)], sens)
-        bad = _first_bad(prepared, data, part, states)
-        if bad is None and len(sens) < n:
-            bad = (len(sens), next(iter(part.joints), None), "MuJoCo raised a warning or a non-finite state",
-                   _remedy(prepared))
+        # a stepper that stopped early has placed its warning at the step: only rows before it came back
+        bad = _first_bad(prepared, data, part, states, sens, warnings=failure is None)
+        if failure is not None and (bad is None or bad[0] >= len(sens)):
+            # the stepper stopped at its first bad step: all rows it returned are good
+            bad = (len(sens), None, failure, _remedy(prepared))
         if bad is not None:
             idx, joint, why, remedy = bad
             parts.append(_thin(part.sliced(slice(0, idx)), done, every))
@@ -178,11 +188,11 @@ def _thin(part, first_step: int, every: int):
 
 
 class _StepFailure(Exception):
-    """A stepper stopped early; carries what it computed."""
+    """A stepper stopped at its first bad step; carries the rows before it and the reason."""
 
-    def __init__(self, states, sens, data):
-        super().__init__("step failure")
-        self.states, self.sens, self.data = states, sens, data
+    def __init__(self, states, sens, data, reason: str):
+        super().__init__(reason)
+        self.states, self.sens, self.data, self.reason = states, sens, data, reason
 
 
 def _initial_qpos(prepared: PreparedModel, targets) -> np.ndarray | None:
@@ -225,18 +235,46 @@ def _rollout_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
     box = {"state": state}
 
     def step(ctrl: np.ndarray, n: int):
-        states, sens = rollout.rollout(model, data, box["state"][None], ctrl[None], nstep=n)
-        box["state"] = states[0][-1]
-        return states[0], sens[0], data
+        start, before = box["state"], _warning_count(data)
+        states, sens = rollout.rollout(model, data, start[None], ctrl[None], nstep=n)
+        states, sens = states[0], sens[0]
+        box["state"] = states[-1]
+        if _warning_count(data) > before and np.isfinite(states).all() and np.isfinite(sens).all():
+            # a warning without a non-finite value (a huge acceleration, a full contact
+            # buffer) says nothing about when: step the chunk again to find the step
+            k, fired = _first_warning_step(model, start, ctrl, n)
+            raise _StepFailure(states[:k], sens[:k], data, f"MuJoCo raised warnings {fired}")
+        return states, sens, data
 
     return step
+
+
+def _warning_count(data: mujoco.MjData) -> int:
+    return int(sum(data.warning[i].number for i in range(mujoco.mjtWarning.mjNWARNING.value)))
+
+
+def _first_warning_step(model: mujoco.MjModel, state: np.ndarray, ctrl: np.ndarray, n: int) -> tuple[int, list[str]]:
+    """(index of the first step of a chunk that raises a MuJoCo warning, the warnings' names).
+
+    Replays the chunk from its initial full-physics state with `mujoco.mj_step` (the
+    stepping rollout does; only on this error path). ``ctrl``: (1, nu) held or (n, nu).
+    """
+    data = mujoco.MjData(model)
+    mujoco.mj_setState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    for k in range(n):
+        data.ctrl[:] = ctrl[min(k, len(ctrl) - 1)]
+        mujoco.mj_step(model, data)
+        if _warning_count(data):
+            break
+    fired = [mujoco.mjtWarning(i).name for i in range(mujoco.mjtWarning.mjNWARNING.value) if data.warning[i].number]
+    return k, fired
 
 
 def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
     """Chunks with the exact-LN step loop (LN force imposed on the ring rows each step)."""
     import copy
 
-    from clearance.contact_calibration.exact_ln import ExactLNContact, step_exact_ln
+    from clearance.contact_calibration.exact_ln import ExactLNContact, ExactLNStepError, step_exact_ln
 
     model = copy.copy(prepared.model)  # ExactLNContact raises pair margins in place
     for j in prepared.mechanism.clearance_joints:
@@ -255,8 +293,9 @@ def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
     def step(ctrl: np.ndarray, n: int):
         try:
             run = step_exact_ln(model, data, contacts, n, ctrl=ctrl if len(ctrl) == n else ctrl[0])
-        except RuntimeError as err:
-            raise _StepFailure(np.zeros((0, 1)), np.zeros((0, model.nsensordata)), data) from err
+        except ExactLNStepError as err:
+            run = err.partial  # the steps before the failing one
+            raise _StepFailure(np.hstack([run.qpos, run.qvel]), run.sensordata, data, err.reason) from err
         return np.hstack([run.qpos, run.qvel]), run.sensordata, data
 
     return step
@@ -296,18 +335,25 @@ def _finish(parts, prepared: PreparedModel, t0: float, *, nstep_done: int, every
     return res
 
 
-def _first_bad(prepared: PreparedModel, data: mujoco.MjData, part, states: np.ndarray):
-    """(row index, joint, reason, remedy) of the first bad row, or None."""
-    fired = [mujoco.mjtWarning(i).name for i in range(mujoco.mjtWarning.mjNWARNING.value) if data.warning[i].number > 0]
+def _first_bad(prepared: PreparedModel, data: mujoco.MjData, part, states: np.ndarray, sens: np.ndarray, *,
+               warnings: bool = True):
+    """(row index, joint or None, reason, remedy) of a chunk's first bad row, or None.
+
+    Rows from the index on are dropped. A row is bad when its journal is beyond the
+    divergence bound (that joint is named) or its state or sensors are not finite (no
+    joint is named: the cause cannot be tied to one). State row i is after step i and
+    sensor row i before it, so a step that goes non-finite drops its own row. With
+    ``warnings``, MuJoCo warnings the stepper could not place drop the whole chunk.
+    """
     n = len(part.times)
-    finite = np.isfinite(states).all(axis=1)
+    finite = np.isfinite(states[:n]).all(axis=1) & np.isfinite(sens[:n]).all(axis=1)
     first_nan = int(np.argmin(finite)) if not finite.all() else n
     worst = (n, None, None)
     for name, jr in part.joints.items():
         lim = prepared.sizing[name].penetration_limit
-        over = np.nonzero(~(jr.penetration <= lim))[0]
+        over = np.nonzero(jr.penetration > lim)[0]
         if len(over) and over[0] < worst[0]:
-            worst = (int(over[0]), name, float(np.nanmax(jr.penetration[over[0]:over[0] + 1])))
+            worst = (int(over[0]), name, float(jr.penetration[over[0]]))
     remedy = _remedy(prepared)
     if worst[1] is not None and worst[0] <= first_nan:
         lim = prepared.sizing[worst[1]].penetration_limit
@@ -316,12 +362,11 @@ def _first_bad(prepared: PreparedModel, data: mujoco.MjData, part, states: np.nd
             f"{lim * 1e6:.3g} um (4 x the Hertz penetration of the expected hardest impact)"
         ), remedy
     if first_nan < n:
-        joint = next(iter(part.joints), None)
-        return max(first_nan - 1, 0), joint, "the state became non-finite (NaN or Inf)", remedy
-    if fired:
-        joint = next(iter(part.joints), None)
-        idx = max(n - 1, 0)
-        return idx, joint, f"MuJoCo raised warnings {fired} in this chunk", remedy
+        return first_nan, None, "the state became non-finite (NaN or Inf)", remedy
+    fired = [mujoco.mjtWarning(i).name for i in range(mujoco.mjtWarning.mjNWARNING.value) if data.warning[i].number > 0]
+    if warnings and fired:
+        # a stepper that could not say when: keep only what preceded the chunk
+        return 0, None, f"MuJoCo raised warnings {fired} during this chunk", remedy
     return None
 
 

@@ -83,6 +83,7 @@ _LAZY = {
     "impose_exact_ln": "exact_ln",
     "step_exact_ln": "exact_ln",
     "ExactLNRun": "exact_ln",
+    "ExactLNStepError": "exact_ln",
     "ExactLNCost": "exact_ln",
     "exact_ln_impact": "exact_ln",
     "exact_ln_cost": "exact_ln",

@@ -38,7 +38,7 @@ from clearance.mjcf.probe import ring_scene
 from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters, ModelOptions
 
-__all__ = ["ExactLNContact", "impose_exact_ln", "step_exact_ln", "ExactLNRun", "exact_ln_impact", "polygon_margin", "ExactLNCost", "exact_ln_cost"]
+__all__ = ["ExactLNContact", "impose_exact_ln", "step_exact_ln", "ExactLNRun", "ExactLNStepError", "exact_ln_impact", "polygon_margin", "ExactLNCost", "exact_ln_cost"]
 
 _TINY_SPEED = 1e-9  # m/s: floor of the recorded approach speed (grazing onsets)
 
@@ -213,6 +213,20 @@ class ExactLNRun:
     penetration: np.ndarray
 
 
+class ExactLNStepError(RuntimeError):
+    """An exact-LN step raised a MuJoCo warning or gave a non-finite state.
+
+    Attributes:
+        step: index of the failing step.
+        reason: what went wrong, for messages.
+        partial: the `ExactLNRun` of the steps before it (all good).
+    """
+
+    def __init__(self, message: str, *, step: int, reason: str, partial: ExactLNRun) -> None:
+        super().__init__(message)
+        self.step, self.reason, self.partial = step, reason, partial
+
+
 def step_exact_ln(
     model: mujoco.MjModel, data: mujoco.MjData, contacts: list[ExactLNContact], nstep: int,
     *, ctrl: np.ndarray | None = None,
@@ -231,7 +245,8 @@ def step_exact_ln(
         The run's states, sensors, LN forces and penetrations.
 
     Raises:
-        RuntimeError: a MuJoCo warning or a non-finite state (the step it happened at).
+        ExactLNStepError: a MuJoCo warning or a non-finite state; it names the step and
+            carries the run before it.
     """
     per_step = ctrl is not None and np.ndim(ctrl) == 2
     if ctrl is not None and not per_step:
@@ -250,9 +265,15 @@ def step_exact_ln(
         pen[i] = [c.last_penetration for c in contacts]
         mujoco.mj_step2(model, data)
         qpos[i], qvel[i], sens[i] = data.qpos, data.qvel, data.sensordata
-        if int(data.warning.number.sum()) > warn0 or not np.all(np.isfinite(data.qvel)):
-            raise RuntimeError(f"exact-LN run failed at step {i} (t = {data.time:.6g} s): MuJoCo "
-                               "warning or non-finite state")
+        fired = [mujoco.mjtWarning(k).name for k in range(mujoco.mjtWarning.mjNWARNING.value)
+                 if data.warning[k].number] if int(data.warning.number.sum()) > warn0 else []
+        finite = bool(np.all(np.isfinite(data.qvel)) and np.all(np.isfinite(data.sensordata)))
+        if fired or not finite:
+            reason = (f"MuJoCo raised warnings {fired}" if fired else "") + (
+                (" and " if fired else "") + "the state became non-finite (NaN or Inf)" if not finite else "")
+            partial = ExactLNRun(qpos[:i], qvel[:i], sens[:i], force[:i], pen[:i])
+            raise ExactLNStepError(f"exact-LN run failed at step {i} (t = {data.time:.6g} s): {reason}",
+                                   step=i, reason=reason, partial=partial)
     return ExactLNRun(qpos, qvel, sens, force, pen)
 
 

@@ -119,6 +119,58 @@ def test_divergence_names_time_joint_and_keeps_partial():
     assert err.partial.times[-1] < err.time + 1e-12
 
 
+@pytest.mark.parametrize("stiffness, reason", [
+    # per-row stiffness far beyond any bearing's (it passes validation: finite and > 0)
+    (1e300, "the state became non-finite"),  # the first contact step overflows to Inf/NaN
+    (1e100, "MuJoCo raised warnings ['mjWARN_BADQACC']"),  # a huge but finite acceleration
+])
+def test_non_finite_or_warning_stops_at_the_first_bad_step(stiffness, reason):
+    from clearance.options import ContactParameters
+
+    h, duration = 1e-6, 0.5e-3
+    absurd = {"rod_slider": ContactParameters(stiffness=stiffness, damping=0.0)}
+    with pytest.raises(SimulationError) as info:
+        # one chunk of 500 steps: the bad step lies inside it, not at its end
+        simulate(slider_crank(), duration=duration, contact=absurd, options=ModelOptions(segments=36, timestep=h))
+    err = info.value
+    assert reason in str(err) and "Remedy: use a smaller time step" in str(err)
+    assert f"diverged at t = {err.time:.6g} s:" in str(err)
+    # the cause is the model's state, not one joint's penetration: no joint is named
+    assert err.joint is None and "at joint" not in str(err)
+    # it happens at the first contact (about 0.23 ms: REFERENCES.md section 6 gives the first
+    # impact at about 0.25 ms), well before the chunk ends at 0.5 ms
+    assert 0.2e-3 < err.time < 0.3e-3
+    p = err.partial
+    assert p is not None and len(p.times) == round(err.time / h)  # every row before the bad step
+    assert p.times[-1] == pytest.approx(err.time - h, abs=1e-12)  # 1e-12 s: rounding of k h
+    for series in (p.outputs["slider_x_acc"], p.joints["rod_slider"].contact_force, p.drive_torque, p.link_poses):
+        assert np.all(np.isfinite(series))
+
+
+def test_exact_ln_step_failure_carries_the_steps_before_it():
+    import copy
+
+    import mujoco
+
+    from clearance.contact_calibration import ExactLNContact, ExactLNStepError, step_exact_ln
+    from clearance.preparation import prepare
+
+    p = prepare(slider_crank(), ModelOptions(segments=36))
+    model = copy.copy(p.model)
+    j = p.mechanism.clearance_joints[0]
+    contact = ExactLNContact(model, j.clearance, p.built.rings[j.name], journal_geom=f"{j.name}__journal",
+                             bearing_site=f"{j.name}__bearing")
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    ctrl = np.tile(data.ctrl, (6, 1))
+    ctrl[3] = np.nan  # a bad control at step 3: MuJoCo warns (and zeroes it)
+    with pytest.raises(ExactLNStepError) as info:
+        step_exact_ln(model, data, [contact], 6, ctrl=ctrl)
+    err = info.value
+    assert err.step == 3 and "mjWARN_BADCTRL" in err.reason and "at step 3" in str(err)
+    assert len(err.partial.qpos) == 3 and np.all(np.isfinite(err.partial.qvel))  # the three good steps
+
+
 def test_bad_arguments_fail_before_work():
     with pytest.raises(ValueError, match="duration must be a positive"):
         simulate(slider_crank(), duration=-1.0)
