@@ -91,6 +91,7 @@ _LAZY = {
     # effective mass
     "EffectiveMass": "effective_mass",
     "cycle_effective_mass": "effective_mass",
+    "normal_effective_mass": "effective_mass",
     # report / CLI
     "calibration_report": "report",
     "accuracy_table": "report",

@@ -26,7 +26,7 @@ from clearance.kinematics import solve_kinematics
 from clearance.mjcf.spec import BuiltModel
 from clearance.model import DriveKind, Mechanism
 
-__all__ = ["EffectiveMass", "cycle_effective_mass"]
+__all__ = ["EffectiveMass", "cycle_effective_mass", "normal_effective_mass"]
 
 
 @dataclass(frozen=True)
@@ -105,8 +105,8 @@ def _constraint_rows(model: mujoco.MjModel, data: mujoco.MjData, mechanism: Mech
     return np.array(rows).reshape(-1, model.nv)
 
 
-def _bearing_mass(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndarray,
-                  n_dir: int) -> float:
+def _mobility(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndarray) -> np.ndarray:
+    """A = J W Jᵀ (2, 2) [1/kg]: journal-to-bearing mobility in world xy with rows g held."""
     nv = model.nv
     minv = np.zeros((nv, nv))
     mujoco.mj_solveM(model, data, minv, np.eye(nv))
@@ -119,11 +119,51 @@ def _bearing_mass(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.
         sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, site)
         mujoco.mj_jacSite(model, data, jac[k], None, sid)
     jrel = (jac[0] - jac[1])[:2]
-    a = jrel @ w @ jrel.T
+    return jrel @ w @ jrel.T
+
+
+def _bearing_mass(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndarray,
+                  n_dir: int) -> float:
+    a = _mobility(model, data, joint, g)
     ang = np.linspace(0, np.pi, n_dir, endpoint=False)
     n = np.stack([np.cos(ang), np.sin(ang)], axis=1)
     inv = np.einsum("ni,ij,nj->n", n, a, n)
     return float(np.median(1.0 / np.maximum(inv, 1e-300)))
+
+
+def normal_effective_mass(
+    model: mujoco.MjModel, data: mujoco.MjData, mechanism: Mechanism, joint: str,
+    normal: np.ndarray, *, lock_velocity_drives: bool = True,
+) -> float:
+    """Effective mass a journal impact sees along one normal, at the data's current pose.
+
+    The same 1 / (nᵀ A n) as `cycle_effective_mass` (loop closures and, by default,
+    velocity drives held), for one direction instead of the median over directions: the
+    mass of a particular impact.
+
+    Args:
+        model: the compiled clearance model.
+        data: its data at the pose of interest (positions are read; `mujoco.mj_forward`
+            is called on it).
+        mechanism: the mechanism.
+        joint: clearance joint name.
+        normal: (2,) contact normal in world xy (normalised here).
+        lock_velocity_drives: treat constant-speed and servo drives as locked.
+
+    Returns:
+        The effective mass [kg].
+
+    Raises:
+        ValueError: a zero or non-finite normal.
+    """
+    n = np.asarray(normal, dtype=float).reshape(2)
+    size = float(np.hypot(*n))
+    if not (np.isfinite(size) and size > 0):
+        raise ValueError(f"normal must be a non-zero finite (x, y) vector (got {tuple(n)})")
+    n = n / size
+    mujoco.mj_forward(model, data)
+    g = _constraint_rows(model, data, mechanism, lock_velocity_drives)
+    return float(1.0 / max(n @ _mobility(model, data, joint, g) @ n, 1e-300))
 
 
 def cycle_effective_mass(
