@@ -45,6 +45,40 @@ def test_models_compile_and_step_without_warnings(at, pair):
     _step_without_warnings(xml)
 
 
+def _cli_geom_pairs() -> list[tuple[str, str]]:
+    from clearance.cli_options import JOURNAL_GEOMS, SEGMENT_GEOMS
+
+    return [(j, s) for j in JOURNAL_GEOMS for s in SEGMENT_GEOMS]
+
+
+@pytest.mark.parametrize("pair", _cli_geom_pairs(), ids=lambda p: f"{p[0]}-{p[1]}")
+def test_every_cli_geom_pair_touches_and_steps_without_warnings(pair):
+    """Each journal/segment geom pair `clearance run` offers, with its journals started in contact."""
+    from clearance.initial_state import offset_journals
+
+    mech = slider_crank(clearance_at=("crank_rod", "rod_slider"), crank_speed=200 * 2 * np.pi / 60)
+    xml = prepare(mech, ModelOptions(segments=36, journal_geom=pair[0], segment_geom=pair[1], timestep=2e-6)).to_xml()
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    c = 0.5e-3  # the builder's radial clearance
+    # 2 um into each ring, so both are in contact from the first step: one journal towards a
+    # segment centre, the other between two segments (36 segments: pitch 10 deg)
+    targets = {"rod_slider": (c + 2e-6, 0.0), "crank_rod": ((c + 2e-6) * np.cos(np.pi / 36), (c + 2e-6) * np.sin(np.pi / 36))}
+    data.qpos[:] = offset_journals(model, model.key_qpos[0], targets, bearings={k: c for k in targets},
+                                   fixed_joints=["crank_pivot"])
+    touched = set()
+    for _ in range(2000):
+        mujoco.mj_step(model, data)
+        touched |= {model.geom(data.contact.geom1[k]).name.split("__")[0] for k in range(data.ncon)}
+        touched |= {model.geom(data.contact.geom2[k]).name.split("__")[0] for k in range(data.ncon)}
+    fired = {mujoco.mjtWarning(i).name: data.warning[i].number for i in range(mujoco.mjtWarning.mjNWARNING.value)
+             if data.warning[i].number}
+    assert not fired, f"MuJoCo warnings: {fired}"
+    assert {"crank_rod", "rod_slider"} <= touched  # both journals met their rings
+    assert np.all(np.isfinite(data.qpos))
+
+
 def test_body_tree_cuts_clearance_joints_first():
     one = body_tree(slider_crank(clearance_at=("rod_slider",)))
     assert [j.name for j in one.cuts] == ["rod_slider"]
