@@ -52,8 +52,11 @@ class SettingRow:
         status: ``ok`` or ``error`` (accuracy or timing run failed).
         error_message: the error a user sees, for failed settings.
         wall_per_rev: wall time per drive revolution [s] (one thread).
-        speedup: reference wall time / this one (same call).
-        speedup_fixed: fixed time per revolution / this one (NaN where none is given).
+        cpu_per_rev: CPU time per drive revolution [s] (equal to the wall time on a quiet
+            machine; steadier on a shared one).
+        speedup: reference CPU time / this one (same call).
+        speedup_fixed: fixed time per revolution / this setting's CPU time (NaN where none
+            is given).
         first_impact: joint -> quantity -> relative error (``onset``: difference [s]).
         first_impact_error: worst |relative error| of the first-impact quantities.
         separation: joint -> separation time from the reference [s].
@@ -70,6 +73,7 @@ class SettingRow:
     status: str
     error_message: str = ""
     wall_per_rev: float = math.nan
+    cpu_per_rev: float = math.nan
     speedup: float = math.nan
     speedup_fixed: float = math.nan
     first_impact: dict[str, dict[str, float]] = field(default_factory=dict)
@@ -150,9 +154,10 @@ def compare_scenario(scenario: Scenario, out_dir: str | Path, *, fixed_per_rev: 
             continue
         row.segments = dict(acc["metadata"].get("segments") or {})
         row.wall_per_rev = tim["wall_per_rev_s"]
-        row.speedup = ref_t["wall_per_rev_s"] / row.wall_per_rev
+        row.cpu_per_rev = tim.get("cpu_per_rev_s", row.wall_per_rev)
+        row.speedup = ref_t.get("cpu_per_rev_s", ref_t["wall_per_rev_s"]) / row.cpu_per_rev
         if fixed_per_rev:
-            row.speedup_fixed = fixed_per_rev / row.wall_per_rev
+            row.speedup_fixed = fixed_per_rev / row.cpu_per_rev
         row.first_impact = {j: first_impact_errors(_first(acc, j), _first(ref, j)) for j in ref["first_impact"]}
         row.first_impact_error = max(abs(e[k]) for e in row.first_impact.values() for k in _FIRST)
         row.separation = _separation(out, scenario.name, st.key, ref)
@@ -193,7 +198,7 @@ def pareto_front(rows: Sequence[SettingRow], error: str) -> list[SettingRow]:
     """
     ok = [r for r in rows if r.status == "ok" and math.isfinite(getattr(r, error))]
     front: list[SettingRow] = []
-    for r in sorted(ok, key=lambda r: (r.wall_per_rev, getattr(r, error))):
+    for r in sorted(ok, key=lambda r: (r.cpu_per_rev, getattr(r, error))):
         if not front or getattr(r, error) < getattr(front[-1], error):
             front.append(r)
     return front
@@ -212,7 +217,7 @@ def choose_defaults(rows: Sequence[SettingRow], *, statistics_tol: float = 0.05,
 
     def fastest(pred) -> SettingRow | None:
         good = [r for r in ok if pred(r)]
-        return min(good, key=lambda r: r.wall_per_rev) if good else None
+        return min(good, key=lambda r: r.cpu_per_rev) if good else None
 
     return {
         "statistics": fastest(lambda r: r.statistics_error <= statistics_tol),
@@ -242,19 +247,19 @@ def speed_error_markdown(scenario: Scenario, rows: Sequence[SettingRow], *, refe
     """
     stats = list(STATISTICS)
     lines = [f"## {scenario.name}", "", scenario.description, "",
-             f"Reference: {reference_per_rev:.3g} s per revolution. Accuracy runs: {scenario.revolutions:g} revolutions, "
+             f"Reference: {reference_per_rev:.3g} s CPU time per revolution. Accuracy runs: {scenario.revolutions:g} revolutions, "
              f"statistics over revolutions {scenario.skip_revolutions:g}–{scenario.revolutions:g} in "
              f"{scenario.blocks} blocks; timing runs: {scenario.timing_revolutions:g} revolutions.", ""]
     if ref_scatter:
         lines += ["Reference scatter (relative standard error of each statistic, worst joint): "
                   + ", ".join(f"{k} {100 * v:.1f} %" for k, v in ref_scatter.items()) + ".", ""]
-    head = ["setting", "N", "wall/rev [ms]", "× ref"] + (["× fixed"] if fixed_per_rev else []) + [
+    head = ["setting", "N", "CPU/rev [ms]", "wall/rev [ms]", "× ref"] + (["× fixed"] if fixed_per_rev else []) + [
         "first impact: F, δ, impulse [%]", "separates [ms]"] + [f"{s} [%]" for s in stats] + ["worst stat [%]"]
     lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-    for r in sorted(rows, key=lambda r: (r.status != "ok", r.wall_per_rev)):
+    for r in sorted(rows, key=lambda r: (r.status != "ok", r.cpu_per_rev)):
         if r.status != "ok":
-            lines.append(f"| {r.label} | | | | " + ("| " if fixed_per_rev else "")
-                         + f"{r.error_message.splitlines()[0][:160]} |" + " |" * (len(head) - 5 - bool(fixed_per_rev)))
+            lines.append(f"| {r.label} | | | | | " + ("| " if fixed_per_rev else "")
+                         + f"{r.error_message.splitlines()[0][:160]} |" + " |" * (len(head) - 6 - bool(fixed_per_rev)))
             continue
         fi = "; ".join(", ".join(_pct(e[k]) for k in _FIRST) for e in r.first_impact.values())
         sep = ", ".join(f"{1e3 * v:.2f}" for v in r.separation.values())
@@ -264,7 +269,7 @@ def speed_error_markdown(scenario: Scenario, rows: Sequence[SettingRow], *, refe
             e = worst.get(s)
             cells.append("–" if e is None else f"{_pct(e['error'])} ±{100 * e['scatter']:.1f}")
         segs = ", ".join(str(v) for v in r.segments.values())
-        row = [r.label, segs, f"{1e3 * r.wall_per_rev:.2f}", _speed(r.speedup)] + (
+        row = [r.label, segs, f"{1e3 * r.cpu_per_rev:.2f}", f"{1e3 * r.wall_per_rev:.2f}", _speed(r.speedup)] + (
             [_speed(r.speedup_fixed)] if fixed_per_rev else []) + [fi, sep] + cells + [f"{100 * r.statistics_error:.1f}"]
         lines.append("| " + " | ".join(row) + " |")
     lines.append("")

@@ -88,6 +88,7 @@ def write_report(scenarios: Sequence[Scenario], out_dir: str | Path, *, command:
         The Markdown path.
     """
     import json
+    import os
     import platform
     import time
 
@@ -102,16 +103,21 @@ def write_report(scenarios: Sequence[Scenario], out_dir: str | Path, *, command:
         fixed = FIXED_PER_REV.get(sc.name)
         rows[sc.name] = compare_scenario(sc, out, fixed_per_rev=fixed)
         ref_t = json.loads((out / "timing" / sc.name / f"{REFERENCE}.json").read_text())
-        parts.append(speed_error_markdown(sc, rows[sc.name], reference_per_rev=ref_t["wall_per_rev_s"],
+        parts.append(speed_error_markdown(sc, rows[sc.name], reference_per_rev=ref_t.get("cpu_per_rev_s", ref_t["wall_per_rev_s"]),
                                           fixed_per_rev=fixed, ref_scatter=reference_scatter(sc, out)))
     plot_speed_error(rows, path=out / "speed_error.png")
+    loads = [json.loads(f.read_text()).get("load_average") for f in (out / "timing").rglob("*.json")]
+    loads = [x for x in loads if x is not None]
+    load_text = (f"1-minute load average during the timing runs {min(loads):.1f}–{max(loads):.1f} on "
+                 f"{os.cpu_count()} CPUs" if loads else "load not recorded")
     head = [
         "# Speed against error", "",
-        f"Command: `{command}`. Machine: {platform.machine()}, {platform.python_version()}; "
-        f"written {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}.", "",
-        "Columns: wall time per drive revolution (MuJoCo stepping and readout, one thread; model preparation "
-        "apart), speed-up against the reference solver timed in the same call (× ref) and against a fixed "
-        "1.5 s per revolution (× fixed, default scenario only); first impact: relative errors of peak "
+        f"Command: `{command}`. Machine: {platform.machine()}, Python {platform.python_version()}, "
+        f"{load_text}; written {time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}.", "",
+        "Columns: CPU and wall time per drive revolution (MuJoCo stepping and readout, one thread; model "
+        "preparation apart; the speed-ups use the CPU time, which is the steadier on a shared machine and "
+        "equals the wall time on a quiet one), speed-up against the reference solver timed in the same call "
+        "(× ref) and against a fixed 1.5 s per revolution (× fixed, default scenario only); first impact: relative errors of peak "
         "contact force, maximum penetration and impulse of each joint's first impact (deterministic); the time "
         "the run separates from the reference (journal centres 10 % of the clearance apart); statistics: "
         "relative error against the reference with ± the combined standard error of both runs (batch means), "

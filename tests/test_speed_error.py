@@ -116,7 +116,8 @@ def test_pareto_front_and_defaults() -> None:
     from clearance.analysis.speed_error_report import SettingRow, choose_defaults, pareto_front
 
     def row(key, wall, stat, first):
-        return SettingRow("s", key, key, {}, "ok", wall_per_rev=wall, statistics_error=stat, first_impact_error=first)
+        return SettingRow("s", key, key, {}, "ok", wall_per_rev=wall, cpu_per_rev=wall, statistics_error=stat,
+                          first_impact_error=first)
 
     rows = [row("a", 1.0, 0.20, 0.05), row("b", 2.0, 0.04, 0.02), row("c", 3.0, 0.06, 0.004),
             row("d", 4.0, 0.01, 0.008), SettingRow("s", "e", "e", {}, "error", "boom")]
