@@ -45,6 +45,8 @@ __all__ = [
     "poincare_from_result",
     "poincare_section",
     "quantity_series",
+    "run_section",
+    "RunSection",
 ]
 
 _JOINT_PARTS = {"ex": ("eccentricity", 0), "ey": ("eccentricity", 1), "vx": ("eccentricity_rate", 0),
@@ -211,6 +213,60 @@ def poincare_from_result(
     names = [quantities] if isinstance(quantities, str) else list(quantities)
     vals = np.column_stack([quantity_series(result, q) for q in names])
     return poincare_section(result.times, vals, period or drive_period(result), phase=phase, last=last)
+
+
+@dataclass(frozen=True)
+class RunSection:
+    """A run's Poincaré section after its start-up transient, classified.
+
+    Attributes:
+        quantities: the sampled quantity names (columns).
+        times: (K,) section times [s].
+        points: (K, d) section points.
+        trajectory: (n, d) the quantities from the first section time on.
+        scale: RMS radius of that trajectory about its mean [units of the points]: the
+            grouping scale `classify_poincare` is given (robust to a slow transient).
+        classification: the set's regime; None when there is no section point.
+    """
+
+    quantities: tuple[str, ...]
+    times: np.ndarray
+    points: np.ndarray
+    trajectory: np.ndarray
+    scale: float
+    classification: PoincareClassification | None
+
+
+def run_section(
+    result: SimulationResult,
+    quantities: str | list[str],
+    *,
+    period: float | None = None,
+    skip: float = 0.0,
+    last: int | None = None,
+) -> RunSection:
+    """Poincaré section of a run (`poincare_from_result`) after ``skip``, classified.
+
+    Args:
+        result: a run.
+        quantities: one name or a list of names (`quantity_series`), in comparable units.
+        period: drive period [s]; default from the recorded drive speed.
+        skip: start-up transient [s] from the run's start; earlier section points are
+            dropped.
+        last: keep at most the last ``last`` section points.
+
+    Raises:
+        KeyError: unknown quantity.
+    """
+    names = [quantities] if isinstance(quantities, str) else list(quantities)
+    ts, pts = poincare_from_result(result, names, period=period, last=last)
+    keep = ts >= result.times[0] + skip
+    ts, pts = ts[keep], pts[keep]
+    sel = result.times >= (ts[0] if len(ts) else np.inf)
+    vals = np.column_stack([quantity_series(result, q)[sel] for q in names])
+    scale = float(np.sqrt(np.mean(np.sum((vals - vals.mean(axis=0)) ** 2, axis=1)))) if len(vals) else 0.0
+    cls = classify_poincare(pts, scale=scale) if len(pts) else None
+    return RunSection(tuple(names), ts, pts, vals, scale, cls)
 
 
 def correlation_dimension(points: np.ndarray, *, r_quantiles: tuple[float, float] = (0.02, 0.2)) -> float:

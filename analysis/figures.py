@@ -35,7 +35,8 @@ __all__ = [
 ]
 
 _PARAMS = {"radial_clearance": ("radial clearance", "mm", 1e3), "clearance": ("radial clearance", "mm", 1e3),
-           "crank_speed": ("crank speed", "rpm", 30 / np.pi), "speed": ("crank speed", "rpm", 30 / np.pi)}
+           "crank_speed": ("crank speed", "rpm", 30 / np.pi), "speed": ("crank speed", "rpm", 30 / np.pi),
+           "crank2_speed": ("crank 2 speed", "rad/s", 1.0)}
 _MODE_COLOURS = {ContactMode.IMPACT: "C3", ContactMode.CONTINUOUS: "C0"}
 
 
@@ -169,6 +170,8 @@ def plot_poincare(
     *,
     trajectory: np.ndarray | None = None,
     path: str | Path | None = None,
+    ax: plt.Axes | None = None,
+    label: str | None = None,
 ) -> plt.Figure:
     """Poincaré section of two quantities, coloured by section index, with the regime.
 
@@ -178,9 +181,14 @@ def plot_poincare(
         classification: regime to show in the title.
         trajectory: (n, 2) full trajectory of the same quantities, drawn in grey behind.
         path: PNG path to save to.
+        ax: axes to draw into (a panel of a larger figure); default a new figure.
+        label: text put before the title (e.g. the run's clearance).
     """
     (l1, u1, s1), (l2, u2, s2) = quantity_label(names[0]), quantity_label(names[1])
-    fig, ax = plt.subplots(figsize=(6.5, 5.5))
+    if ax is None:
+        fig, ax = plt.subplots(figsize=(6.5, 5.5))
+    else:
+        fig = ax.figure
     if trajectory is not None:
         ax.plot(trajectory[:, 0] * s1, trajectory[:, 1] * s2, lw=0.3, color="0.7", label="trajectory")
     sc = ax.scatter(points[:, 0] * s1, points[:, 1] * s2, c=np.arange(len(points)), s=12, cmap="viridis",
@@ -190,7 +198,8 @@ def plot_poincare(
         ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(f"{l1} [{u1}]")
     ax.set_ylabel(f"{l2} [{u2}]")
-    title = "Poincaré section (t = kT)"
+    title = f"{label}: " if label else ""
+    title += "Poincaré section (t = kT)"
     if classification is not None:
         c = classification
         title += f": {c.regime.value.replace('_', '-')}"

@@ -86,7 +86,7 @@ class SweepEvaluation:
 
     def __call__(self, result: Any, ideal: Any, mechanism: Any) -> dict[str, Any]:
         """Row fields of one run (see the module docstring)."""
-        from clearance.analysis.chaos import classify_poincare, poincare_from_result, quantity_series
+        from clearance.analysis.chaos import run_section
         from clearance.analysis.statistics import deviation_statistics, per_cycle_mean_deviation
         from clearance.analysis.summary import joint_summary
 
@@ -101,15 +101,10 @@ class SweepEvaluation:
                 result, ideal, output, period=period, skip=skip
             ).tolist()
         names = list(self.poincare or (output, f"{output}_vel"))
-        ts, pts = poincare_from_result(result, names, period=period, last=self.last_periods)
-        keep = ts >= result.times[0] + skip
-        ts, pts = ts[keep], pts[keep]
-        sel = result.times >= (ts[0] if len(ts) else np.inf)
-        vals = np.column_stack([quantity_series(result, q)[sel] for q in names])
-        scale = float(np.sqrt(np.mean(np.sum((vals - vals.mean(axis=0)) ** 2, axis=1)))) if len(vals) else 0.0
-        regime = classify_poincare(pts, scale=scale).regime.value if len(pts) else "undetermined"
-        row["poincare"] = {"quantities": names, "times": ts.tolist(), "points": pts.tolist(),
-                           "scale": scale, "regime": regime}
+        sec = run_section(result, names, period=period, skip=skip, last=self.last_periods)
+        regime = sec.classification.regime.value if sec.classification else "undetermined"
+        row["poincare"] = {"quantities": names, "times": sec.times.tolist(), "points": sec.points.tolist(),
+                           "scale": sec.scale, "regime": regime}
         return row
 
 

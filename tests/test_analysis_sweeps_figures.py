@@ -145,7 +145,8 @@ def test_cli_sweep_and_rank(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("module", ["statistics", "response", "chaos", "sweep", "bifurcation", "criticality",
-                                    "figures", "report", "cli_commands"])
+                                    "figures", "report", "cli_commands", "comparisons", "run_store",
+                                    "comparison_figures", "ideal_runs"])
 def test_every_public_argument_is_documented(module):
     import importlib
     import inspect
