@@ -87,9 +87,12 @@ def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, cont
 
 def add_numerics_args(p: argparse.ArgumentParser, *, contact_mode: bool = True) -> None:
     """Add the MuJoCo numerics group: time step, segments, geoms and (optionally) contact mode."""
+    from clearance.options import ModelOptions
+
+    dflt = ModelOptions()
     g = p.add_argument_group("numerics")
-    g.add_argument("--timestep-us", type=positive(float, "--timestep-us"), default=1.0,
-                   help="time step [µs] (default 1)")
+    g.add_argument("--timestep-us", type=positive(float, "--timestep-us"), default=dflt.timestep * 1e6,
+                   help=f"time step [µs] (default {dflt.timestep * 1e6:g}; see benchmarks/speed_error.md)")
     g.add_argument("--segments", type=int, default=None,
                    help="bearing segment count N (default: chosen by the ripple rule)")
     g.add_argument("--journal-geom", default="sphere", choices=JOURNAL_GEOMS,
@@ -97,10 +100,12 @@ def add_numerics_args(p: argparse.ArgumentParser, *, contact_mode: bool = True) 
     g.add_argument("--segment-geom", default="sphere", choices=SEGMENT_GEOMS,
                    help="bearing segment geom (default sphere)")
     if contact_mode:
-        g.add_argument("--contact-mode", default="nominal", choices=CONTACT_MODES,
-                       help="contact parameters: nominal (formulas, default), calibrated (fitted to LN "
-                            "impacts once, then reused from the cache; see 'clearance calibrate') or "
-                            "exact_ln (the LN force imposed every step; slower, frictionless joints only)")
+        g.add_argument("--contact-mode", default=dflt.contact_mode.value, choices=CONTACT_MODES,
+                       help=f"contact parameters (default {dflt.contact_mode.value}): nominal (formulas), "
+                            "calibrated (fitted to LN impacts once, then reused from the cache; see "
+                            "'clearance calibrate') or exact_ln (the LN force imposed every step: every "
+                            "statistic within 3 %% of the reference on the default scenario, about 10x "
+                            "slower; frictionless joints only)")
 
 
 def numerics_given(args: argparse.Namespace) -> list[str]:
@@ -156,5 +161,5 @@ def options_from_args(args: argparse.Namespace):
         timestep=args.timestep_us * 1e-6,
         journal_geom=args.journal_geom,
         segment_geom=args.segment_geom,
-        contact_mode=getattr(args, "contact_mode", None) or "nominal",
+        contact_mode=getattr(args, "contact_mode", None) or ModelOptions().contact_mode,
     )

@@ -134,6 +134,8 @@ def prepare(
         d_imp = (5 * m * v**2 / (4 * K)) ** 0.4
         lim = 4 * max(d_imp, (max(fmax, 1e-9) / K) ** (2 / 3))
         sizing[j.name] = JointSizing(K, fmed, fmax, dtyp, v, m, lim, segs[j.name], masses[j.name].valid_range)
+        # before any calibration: a fit at an unstable step fails with a less useful message
+        _check_time_step(j.name, sizing[j.name], options.timestep)
     params = dict(contact or {})
     for j in cjoints:
         if j.name not in params:
@@ -141,8 +143,6 @@ def prepare(
     apply_contact(built, model, params)
     add_initial_keyframe(built, model, initial_controls(mechanism))
     model = built.spec.compile()
-    for j in cjoints:
-        _check_time_step(j.name, sizing[j.name], options.timestep)
     meta = {
         "segments": segs,
         "journal_geom": options.journal_geom.value,

@@ -21,7 +21,16 @@ def default_prepared(default_mechanism):
     return prepare(default_mechanism, ModelOptions())
 
 
+@pytest.fixture(scope="session")
+def _session_cache(tmp_path_factory):
+    return tmp_path_factory.mktemp("calibration-cache")
+
+
 @pytest.fixture(autouse=True)
-def _calibration_cache(tmp_path, monkeypatch):
-    """Tests never touch the user's calibration cache."""
-    monkeypatch.setenv("CLEARANCE_CACHE_DIR", str(tmp_path / "cache"))
+def _calibration_cache(_session_cache, monkeypatch):
+    """Tests never touch the user's calibration cache; they share one for the session.
+
+    Default runs are calibrated, so a shared cache fits each joint setup once per session.
+    Tests about the cache itself set their own folder.
+    """
+    monkeypatch.setenv("CLEARANCE_CACHE_DIR", str(_session_cache))

@@ -42,7 +42,8 @@ def joint():
 
 @pytest.fixture(scope="module")
 def options():
-    return ModelOptions(segments=72)
+    # the time step of the accuracy measured in benchmarks/calibration_accuracy.md
+    return ModelOptions(segments=72, timestep=1e-6)
 
 
 @pytest.fixture(scope="module")

@@ -17,8 +17,10 @@ from clearance.preparation import prepare
 GOLDEN = Path(__file__).parent / "golden" / "slider_crank.xml"
 
 
-def test_golden_mjcf_for_default_slider_crank(default_prepared):
-    xml = default_prepared.to_xml()
+def test_golden_mjcf_for_default_slider_crank(default_mechanism):
+    # nominal contact: closed-form parameters, so the file is the same on every machine (a
+    # calibrated run's fitted values carry the fit's last digits; their test is elsewhere)
+    xml = prepare(default_mechanism, ModelOptions(contact_mode="nominal")).to_xml()
     if os.environ.get("CLEARANCE_UPDATE_GOLDEN"):
         GOLDEN.write_text(xml)
     assert xml == GOLDEN.read_text(), "regenerate with CLEARANCE_UPDATE_GOLDEN=1 after a deliberate change"
