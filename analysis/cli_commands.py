@@ -16,19 +16,11 @@ import sys
 from collections.abc import Sequence
 from pathlib import Path
 
+from clearance.cli_options import positive
+
 __all__ = ["main_rank", "main_sweep", "rank_parser", "sweep_parser"]
 
 _RPM = 2 * math.pi / 60
-
-
-def _positive(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number (got {text!r})") from None
-    if not (math.isfinite(v) and v > 0):
-        raise argparse.ArgumentTypeError(f"must be > 0 (got {text})")
-    return v
 
 
 def _builder(name: str):
@@ -41,7 +33,7 @@ def _builder(name: str):
 
 def _common(p: argparse.ArgumentParser, out: str) -> None:
     p.add_argument("--mechanism", default="slider_crank", help="catalogue mechanism (default slider_crank)")
-    p.add_argument("--timestep-us", type=_positive, default=5.0, help="time step [µs] (default 5)")
+    p.add_argument("--timestep-us", type=positive(float, "--timestep-us"), default=5.0, help="time step [µs] (default 5)")
     p.add_argument("--segments", type=int, default=None, help="bearing segments N (default: ripple rule)")
     p.add_argument("--out", default=out, help=f"output folder (default {out}); rerun to resume")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="Dask scheduler address (default: local processes)")
@@ -60,12 +52,12 @@ def sweep_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance sweep``."""
     p = argparse.ArgumentParser(prog="clearance sweep", description="Bifurcation diagram over clearance or crank speed.")
     p.add_argument("--parameter", choices=["clearance", "speed"], default="clearance", help="swept parameter")
-    p.add_argument("--start", type=_positive, default=None, help="first value [mm or rpm] (default 0.01 mm / 1000 rpm)")
-    p.add_argument("--stop", type=_positive, default=None, help="last value [mm or rpm] (default 1 mm / 5000 rpm)")
+    p.add_argument("--start", type=positive(float, "--start"), default=None, help="first value [mm or rpm] (default 0.01 mm / 1000 rpm)")
+    p.add_argument("--stop", type=positive(float, "--stop"), default=None, help="last value [mm or rpm] (default 1 mm / 5000 rpm)")
     p.add_argument("--points", type=int, default=200, help="number of values (default 200)")
     p.add_argument("--log", action="store_true", help="logarithmic spacing")
-    p.add_argument("--clearance-mm", type=_positive, default=0.5, help="clearance when sweeping speed [mm]")
-    p.add_argument("--rpm", type=_positive, default=5000.0, help="crank speed when sweeping clearance [rpm]")
+    p.add_argument("--clearance-mm", type=positive(float, "--clearance-mm"), default=0.5, help="clearance when sweeping speed [mm]")
+    p.add_argument("--rpm", type=positive(float, "--rpm"), default=5000.0, help="crank speed when sweeping clearance [rpm]")
     p.add_argument("--quantity", default=None, help="sampled quantity (default <first clearance joint>.ex)")
     p.add_argument("--periods", type=int, default=60, help="drive periods per point (default 60)")
     p.add_argument("--sampled", type=int, default=40, help="last periods sampled (default 40)")
@@ -119,8 +111,8 @@ def main_sweep(argv: Sequence[str] | None = None) -> int:
 def rank_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance rank``."""
     p = argparse.ArgumentParser(prog="clearance rank", description="Rank clearance joints by output deviation.")
-    p.add_argument("--clearances-mm", type=_positive, nargs="+", default=[0.1, 0.5], help="clearances [mm]")
-    p.add_argument("--rpm", type=_positive, nargs="+", default=[1000.0, 3000.0], help="crank speeds [rpm]")
+    p.add_argument("--clearances-mm", type=positive(float, "--clearances-mm"), nargs="+", default=[0.1, 0.5], help="clearances [mm]")
+    p.add_argument("--rpm", type=positive(float, "--rpm"), nargs="+", default=[1000.0, 3000.0], help="crank speeds [rpm]")
     p.add_argument("--joints", nargs="*", default=None, help="joints (default: all but driven/output ground pivots)")
     p.add_argument("--periods", type=int, default=6, help="drive periods per run (default 6; the first is skipped)")
     _common(p, "clearance-rank")
