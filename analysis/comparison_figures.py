@@ -59,6 +59,19 @@ class TrendPanel:
     logy: bool = False
 
 
+def _panel_row(n: int, width: float, height: float, draw, title: str, path: str | Path | None) -> plt.Figure:
+    """A row of ``n`` panels; ``draw(ax, k)`` fills panel k."""
+    fig, axes = plt.subplots(1, n, figsize=(width * n, height), squeeze=False)
+    for k, ax in enumerate(axes[0]):
+        draw(ax, k)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    if path is not None:
+        save_figure(fig, path)
+    return fig
+
+
 def plot_trends(panels: Sequence[TrendPanel], *, title: str = "", path: str | Path | None = None) -> plt.Figure:
     """Panels side by side, each with one line (markers, optional error bars) per series.
 
@@ -67,8 +80,9 @@ def plot_trends(panels: Sequence[TrendPanel], *, title: str = "", path: str | Pa
         title: figure title.
         path: PNG path to save to.
     """
-    fig, axes = plt.subplots(1, len(panels), figsize=(5.2 * len(panels), 4.2), squeeze=False)
-    for ax, p in zip(axes[0], panels):
+
+    def draw(ax: plt.Axes, i: int) -> None:
+        p = panels[i]
         for k, (label, data) in enumerate(p.series.items()):
             x, y = np.asarray(data[0], float), np.asarray(data[1], float)
             err = None if len(data) < 3 or data[2] is None else np.asarray(data[2], float)
@@ -93,12 +107,8 @@ def plot_trends(panels: Sequence[TrendPanel], *, title: str = "", path: str | Pa
             ax.set_title(p.title, fontsize=10)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    if path is not None:
-        save_figure(fig, path)
-    return fig
+
+    return _panel_row(len(panels), 5.2, 4.2, draw, title, path)
 
 
 def plot_output_overlay(
@@ -167,19 +177,6 @@ class OrbitPanel:
     clearance: float
     title: str
     period: float | None = None
-
-
-def _panel_row(n: int, width: float, height: float, draw, title: str, path: str | Path | None) -> plt.Figure:
-    """A row of ``n`` panels; ``draw(ax, k)`` fills panel k."""
-    fig, axes = plt.subplots(1, n, figsize=(width * n, height), squeeze=False)
-    for k, ax in enumerate(axes[0]):
-        draw(ax, k)
-    if title:
-        fig.suptitle(title)
-    fig.tight_layout()
-    if path is not None:
-        save_figure(fig, path)
-    return fig
 
 
 def plot_orbit_phase_panels(

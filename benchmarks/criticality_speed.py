@@ -29,7 +29,7 @@ from clearance.analysis.criticality import ClearanceAtJoint, rank_joints, rankin
 from clearance.analysis.figures import plot_criticality
 from clearance.analysis.sweep import load_rows
 from clearance.builders import rpm, watt_six_bar
-from clearance.options import ModelOptions
+from clearance.options import ContactMode, ModelOptions
 from clearance.results import atomic_write_text
 
 
@@ -94,6 +94,8 @@ def main() -> None:
     p.add_argument("--joints", nargs="*", default=None, help="default: every candidate joint")
     p.add_argument("--periods", type=int, default=6)
     p.add_argument("--workers", type=int, default=2)
+    p.add_argument("--contact-mode", choices=[m.value for m in ContactMode], default="nominal",
+                   help="contact mode (default nominal, the setting of the committed table)")
     p.add_argument("--out", default="criticality-speed")
     p.add_argument("--compare", nargs=2, metavar=("DIR_A", "DIR_B"), help="compare two finished sweeps and exit")
     args = p.parse_args()
@@ -105,7 +107,8 @@ def main() -> None:
     ranking = run_criticality(
         ClearanceAtJoint(watt_six_bar), clearances=[c * 1e-3 for c in args.clearances_mm],
         speeds=[rpm(r) for r in args.rpm], joints=args.joints, out_dir=args.out, periods=args.periods,
-        options=ModelOptions(timestep=args.timestep_us * 1e-6), max_workers=args.workers,
+        options=ModelOptions(timestep=args.timestep_us * 1e-6, contact_mode=ContactMode(args.contact_mode)),
+        max_workers=args.workers,
     )
     wall = time.perf_counter() - t0
     load_after = os.getloadavg()
@@ -120,6 +123,7 @@ def main() -> None:
         "load_average_1_5_15_before": [round(x, 2) for x in load_before],
         "load_average_1_5_15_after": [round(x, 2) for x in load_after],
         "points": len(rows), "failed": len(ranking.failed), "timestep_us": args.timestep_us,
+        "contact_mode": args.contact_mode,
         "periods": args.periods, "wall_s": round(wall, 1),
         "per_point_s_median": round(statistics.median(r["timing"]["wall_time_s"] for r in rows), 2),
         **breakdown(rows, wall, args.workers),

@@ -17,7 +17,15 @@ from clearance.analysis.criticality import ClearanceAtJoint, CriticalityRanking,
 from clearance.analysis.run_store import RunSpec, RunStore, run_batch
 from clearance.analysis.sweep import KeywordFactory
 from clearance.builders import CATALOGUE, rpm, seven_bar_press
-from clearance.options import ModelOptions
+from clearance.options import ContactMode, ModelOptions
+
+CONTACT = ContactMode.CALIBRATED  # contact fitted to LN impacts per joint (the package default)
+
+
+def options(step: float) -> ModelOptions:
+    """The study's numerical options at time step ``step`` [s]."""
+    return ModelOptions(timestep=step, contact_mode=CONTACT)
+
 
 # -- press (REFERENCES.md section 4) -------------------------------------------------------
 PRESS_STEP = 10e-6  # short runs (4 periods); checked against 5 us below
@@ -65,7 +73,7 @@ def _press(at: tuple[str, ...], c_mm: float | None, speed: float, step: float, p
     if c_mm is not None:
         point["radial_clearance"] = c_mm * 1e-3
     return RunSpec(press_name(at, c_mm, speed, step), KeywordFactory(seven_bar_press), point, periods * 2 / speed,
-                   ModelOptions(timestep=step), keep_every=max(1, round(KEEP_INTERVAL / step)))
+                   options(step), keep_every=max(1, round(KEEP_INTERVAL / step)))
 
 
 def press_runs() -> list[RunSpec]:
@@ -95,13 +103,13 @@ def run_press_bifurcations(cache: Path, workers: int) -> dict[str, BifurcationDi
     values_c = [c * 1e-3 for c in BIF_CLEARANCES_MM]
     out = {
         "clearance": run_bifurcation(values_c, over_c, out_dir=cache / "bif_clearance",
-                                     options=ModelOptions(timestep=PRESS_LONG_STEP), **common),
+                                     options=options(PRESS_LONG_STEP), **common),
         "clearance_check": run_bifurcation(values_c[::BIF_CHECK_EVERY], over_c, out_dir=cache / "bif_clearance_check",
-                                           options=ModelOptions(timestep=PRESS_LONG_CHECK_STEP), **common),
+                                           options=options(PRESS_LONG_CHECK_STEP), **common),
     }
     over_w = KeywordFactory(seven_bar_press, fixed={"radial_clearance": BIF_SPEED_CLEARANCE_MM * 1e-3})
     out["speed"] = run_bifurcation([w * math.pi for w in BIF_SPEEDS], over_w, out_dir=cache / "bif_speed",
-                                   parameter="crank2_speed", options=ModelOptions(timestep=PRESS_LONG_STEP), **common)
+                                   parameter="crank2_speed", options=options(PRESS_LONG_STEP), **common)
     return out
 
 
@@ -121,7 +129,7 @@ def _criticality(cache: Path, name: str, grid, workers: int, joints=None) -> Cri
     ranking = run_criticality(
         ClearanceAtJoint(CATALOGUE[name].builder), clearances=[c * 1e-3 for c in clearances],
         speeds=[rpm(s) for s in speeds], joints=joints, out_dir=cache / f"crit_{name}", periods=CRIT_PERIODS,
-        options=ModelOptions(timestep=CRIT_STEP), max_workers=workers,
+        options=options(CRIT_STEP), max_workers=workers,
     )
     return CriticalityRun(name, ranking, tuple(clearances), tuple(speeds), tuple(s.joint for s in ranking.scores))
 

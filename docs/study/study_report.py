@@ -17,8 +17,13 @@ papers: §4, a hybrid-driven seven-bar press with clearances at joints A and C, 
 criticality order of clearance joints in 1-DOF linkages. "In kind" means the same kind of
 effect, not the same numbers: the papers' dimensions, masses and speeds are not available
 to us (the catalogue's press and linkages have the project's own dimensions,
-docs/catalogue/catalogue.md), and we use MuJoCo with ring-segment bearings and nominal LN
-contact (restitution 0.9, no friction) where the papers used their own multibody codes.
+docs/catalogue/catalogue.md), and we use MuJoCo with ring-segment bearings whose contact is
+calibrated to Lankarani-Nikravesh impacts (restitution 0.9; the package's default contact
+mode: per joint, the ring's stiffness and damping are fitted to LN impacts over the joint's
+range of impact speeds) where the papers used their own multibody codes (the press paper
+with LN contact plus Coulomb friction and Baumgarte stabilisation, the criticality paper
+with ADAMS). Our joints are frictionless, and our press has gravity on and both motors at
+the same period.
 Numbers quoted from the papers are as REFERENCES.md gives them; we have not checked them
 against the papers' tables.
 """
@@ -30,8 +35,7 @@ def _runtime(stages: dict, machine: str) -> str:
     return f"""## How the study was run
 
 Machine: {machine}. Wall time of the computing stages (summed over the invocations that
-computed something; the cores were shared with other work during the run, so a quiet
-machine takes less):
+computed something; other work may share the cores, so a quiet machine can take less):
 
 | stage | wall time |
 |---|---:|
@@ -52,7 +56,10 @@ Numerical choices (all in `docs/study/plan.py`):
   {plan.BIF_PERIODS} periods and sample the last {plan.BIF_SAMPLED}, fewer than the benchmark's 60/40, to keep
   the study short: regimes near a transition are indicative.
 - Criticality: h = {plan.CRIT_STEP * 1e6:g} µs and {plan.CRIT_PERIODS} periods, the setting of
-  benchmarks/criticality_speed.md (same ranking as at 1 µs).
+  benchmarks/criticality_speed.md (same ranking as at 1 µs there, with nominal contact).
+- Contact: {plan.CONTACT.value} for every run. The fits (one per joint, clearance and time step) are
+  part of the times above on a fresh calibration cache and are reused afterwards
+  (`$CLEARANCE_CACHE_DIR`).
 - Bearing rings: the segment count comes from the ripple rule; at light joint loads (the
   press at low speed, 100 rpm linkages) no count up to 512 keeps the force ripple under 2 %,
   and the rule falls back to its largest useful count (a warning, silenced here). Contact
