@@ -46,8 +46,8 @@ def build_parser() -> argparse.ArgumentParser:
         sub.add_parser(name, help=f"{text} (see 'clearance {name} --help')", add_help=False)
     r = sub.add_parser("run", help="simulate a scenario and write results, figures and the model")
     _add_scenario_args(r)
-    r.add_argument("--revolutions", type=_positive(float, "--revolutions"), default=3.0,
-                   help="crank revolutions to simulate (default 3)")
+    r.add_argument("--revolutions", type=_positive(float, "--revolutions"), default=None,
+                   help="revolutions of the slowest speed-driven crank to simulate (default 3)")
     r.add_argument("--duration-ms", type=_positive(float, "--duration-ms"), default=None,
                    help="simulated time [ms] (overrides --revolutions)")
     r.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
@@ -56,8 +56,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH")
     f = sub.add_parser("reference", help="run a scenario with the exact-geometry reference solver (slow)")
     _add_scenario_args(f, numerics=False)  # MuJoCo numerics are refused (see _cmd_reference)
-    f.add_argument("--revolutions", type=_positive(float, "--revolutions"), default=1.0,
-                   help="crank revolutions to simulate (default 1)")
+    f.add_argument("--revolutions", type=_positive(float, "--revolutions"), default=None,
+                   help="revolutions of the slowest speed-driven crank to simulate (default 1)")
     f.add_argument("--duration-ms", type=_positive(float, "--duration-ms"), default=None,
                    help="simulated time [ms] (overrides --revolutions)")
     f.add_argument("--rtol", type=_positive(float, "--rtol"), default=1e-9, help="relative tolerance (default 1e-9)")
@@ -93,9 +93,10 @@ def _write_outputs(args, mech, result, ideal, out: Path) -> None:
 
     result.save(out / "result")
     ideal.save(out / "ideal")
-    period = min(d.period for d in mech.drives if d.kind.value != "torque")
-    # statistics skip the first drive period as start-up transient when the run is long enough
-    skip = period if result.times[-1] > 2 * period else 0.0
+    periods = [d.period for d in mech.drives if d.kind.value != "torque"]
+    # statistics skip the first drive period as start-up transient when the run is long enough;
+    # a mechanism driven by torques alone has no period: nothing is skipped
+    skip = min(periods) if periods and result.times[-1] > 2 * min(periods) else 0.0
     if getattr(args, "rerun", None):
         from clearance.analysis.rerun_log import record
         from clearance.analysis.report import joint_sections
@@ -121,10 +122,24 @@ def _write_outputs(args, mech, result, ideal, out: Path) -> None:
         print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * scale:.4g} {unit}")
 
 
-def _duration(args, mech) -> float:
+def _duration(args, mech, default_revolutions: float) -> float:
+    """Simulated time [s]: --duration-ms, else --revolutions of the slowest speed-driven crank.
+
+    Raises:
+        ValueError: --revolutions for a mechanism driven by torques alone (it has no period).
+    """
     from clearance.simulation import default_duration
 
-    return args.duration_ms * 1e-3 if args.duration_ms else default_duration(mech, args.revolutions)
+    if args.duration_ms:
+        return args.duration_ms * 1e-3
+    if all(d.kind.value == "torque" for d in mech.drives):
+        if args.revolutions is not None:
+            raise ValueError(f"--revolutions {args.revolutions:g}: mechanism '{mech.name}' is driven by torques "
+                             "alone and has no drive period; give the simulated time with --duration-ms")
+        duration = default_duration(mech)
+        print(f"{mech.name} is driven by torques alone: simulating {duration:g} s (set it with --duration-ms)")
+        return duration
+    return default_duration(mech, default_revolutions if args.revolutions is None else args.revolutions)
 
 
 def _cmd_run(args) -> int:
@@ -134,11 +149,11 @@ def _cmd_run(args) -> int:
 
     mech = _mechanism(args)
     options = _options(args)
-    duration = _duration(args, mech)
+    duration = _duration(args, mech, 3.0)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     prepared = prepare(mech, options)
     ideal_prepared = prepare(mech.ideal_twin(), options)
+    out.mkdir(parents=True, exist_ok=True)  # only once the models are built: a refused run leaves no folder
     atomic_write_text(out / "model.xml", prepared.to_xml())
     atomic_write_text(out / "ideal_model.xml", ideal_prepared.to_xml())
     print(f"{mech.name}: clearance at {[j.name for j in mech.clearance_joints]}, "
@@ -173,9 +188,8 @@ def _cmd_reference(args) -> int:
             "set its accuracy with --rtol and its output interval with --output-us"
         )
     mech = _mechanism(args)
-    duration = _duration(args, mech)
+    duration = _duration(args, mech, 1.0)
     out = Path(args.out)
-    out.mkdir(parents=True, exist_ok=True)
     print(f"{mech.name} (reference solver): clearance at {[j.name for j in mech.clearance_joints]}, "
           f"{duration * 1e3:.3g} ms, rtol {args.rtol:g}")
     progress = not args.no_progress
@@ -187,7 +201,10 @@ def _cmd_reference(args) -> int:
     if result is None:
         print(f"error: {failed}", file=sys.stderr)
         return 2
-    ideal = run_reference(mech.ideal_twin(), duration, output_interval=args.output_us * 1e-6, rtol=args.rtol)
+    print(f"  ideal twin (no clearance), {duration * 1e3:.3g} ms, for the deviations")
+    ideal = run_reference(mech.ideal_twin(), duration, output_interval=args.output_us * 1e-6, rtol=args.rtol,
+                          progress=progress)
+    out.mkdir(parents=True, exist_ok=True)
     _write_outputs(args, mech, result, ideal, out)
     print(f"  wall time {result.metadata.get('wall_time_s', float('nan')):.3g} s; wrote {out}/")
     if failed is not None:

@@ -132,7 +132,12 @@ def mechanism_from_args(args: argparse.Namespace):
         return load_scenario(args.scenario)
     builder = CATALOGUE[args.mechanism].builder
     accepted = inspect.signature(builder).parameters
-    kw = {}
+    kw, flags = {}, {}
+    for flag, key, value in (("--clearance-mm", "radial_clearance", args.clearance_mm),
+                             ("--clearance-at", "clearance_at", args.clearance_at),
+                             ("--rpm", "crank_speed", args.rpm), ("--gravity", "gravity", args.gravity or None)):
+        if value is not None:
+            flags[key] = flag
     if args.clearance_mm is not None:
         kw["radial_clearance"] = args.clearance_mm * 1e-3
     if args.clearance_at is not None:
@@ -141,9 +146,9 @@ def mechanism_from_args(args: argparse.Namespace):
         kw["crank_speed"] = rpm(args.rpm)
     if args.gravity:
         kw["gravity"] = 9.81
-    refused = [k for k in kw if k not in accepted]
+    refused = [flags[k] for k in kw if k not in accepted]
     if refused:
-        raise ValueError(f"mechanism '{args.mechanism}' does not take {refused} from the command line; "
+        raise ValueError(f"mechanism '{args.mechanism}' does not take {', '.join(refused)} from the command line; "
                          "use a scenario file (--scenario)")
     return builder(**kw)
 

@@ -21,16 +21,14 @@ def default_prepared(default_mechanism):
     return prepare(default_mechanism, ModelOptions())
 
 
-@pytest.fixture(scope="session")
-def _session_cache(tmp_path_factory):
-    return tmp_path_factory.mktemp("calibration-cache")
-
-
-@pytest.fixture(autouse=True)
-def _calibration_cache(_session_cache, monkeypatch):
+@pytest.fixture(scope="session", autouse=True)
+def _calibration_cache(tmp_path_factory):
     """Tests never touch the user's calibration cache; they share one for the session.
 
-    Default runs are calibrated, so a shared cache fits each joint setup once per session.
-    Tests about the cache itself set their own folder.
+    Session-scoped and autouse, so it is set before any other session- or module-scoped
+    fixture prepares a model. Default runs are calibrated, so a shared cache fits each joint
+    setup once per session. Tests about the cache itself set their own folder.
     """
-    monkeypatch.setenv("CLEARANCE_CACHE_DIR", str(_session_cache))
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("CLEARANCE_CACHE_DIR", str(tmp_path_factory.mktemp("calibration-cache")))
+        yield

@@ -141,3 +141,34 @@ def test_joint_that_never_touched_prints_no_contact(tmp_path, capsys):
     assert main(["reference", "--duration-ms", "0.1", "--out", str(tmp_path), "--no-progress"]) == 0
     out = capsys.readouterr().out
     assert "rod_slider: no contact" in out and "max penetration" not in out
+
+
+def test_torque_driven_scenario_runs_and_refuses_revolutions(tmp_path, capsys):
+    """A mechanism driven by torques alone has no period: the run says what it simulates and
+    the statistics skip no transient; --revolutions is refused, not ignored."""
+    import dataclasses
+
+    from clearance.builders import dump_scenario, slider_crank
+    from clearance.model import Drive, DriveKind
+
+    mech = slider_crank(gravity=9.81)
+    drive = mech.drives[0]
+    torque_driven = dataclasses.replace(mech, drives=(Drive(drive.name, drive.joint, kind=DriveKind.TORQUE, torque=0.05),))
+    path = tmp_path / "torque.toml"
+    dump_scenario(torque_driven, path)
+    out = tmp_path / "out"
+    assert main(["run", "--scenario", str(path), "--revolutions", "2", "--out", str(out), "--no-progress"]) == 2
+    assert "--revolutions 2: mechanism 'slider_crank' is driven by torques alone" in capsys.readouterr().err
+    assert not out.exists()  # refused before any work
+    # 1 ms at 20 us: a short, cheap run; the point is that every output is written
+    assert main(["run", "--scenario", str(path), "--duration-ms", "1", "--timestep-us", "20", "--segments", "72",
+                 "--contact-mode", "nominal", "--out", str(out), "--no-progress"]) == 0
+    assert (out / "report.md").stat().st_size > 0 and (out / "summary.csv").stat().st_size > 0
+
+
+def test_refused_time_step_leaves_no_output_folder(tmp_path, capsys):
+    out = tmp_path / "out"
+    # 20 us is far above the default joint's stable step (benchmarks/stability.md: TimeStepError)
+    assert main(["run", "--timestep-us", "20", "--contact-mode", "nominal", "--out", str(out), "--no-progress"]) == 2
+    assert "time step" in capsys.readouterr().err.lower()
+    assert not out.exists()
