@@ -1,9 +1,9 @@
 """Calibrated and exact-LN contact against the LN impact reference; exact-LN cost.
 
-    python benchmarks/calibration_accuracy.py [--out benchmarks/calibration_accuracy.md]
+    python benchmarks/calibration_accuracy.py [--timestep-us 2] [--out benchmarks/calibration_accuracy.md]
 
-Cases (steel, R_B = 10 mm, LN with cₑ = 0.9, sphere journal / sphere segments, 1 µs,
-implicitfast, impedance 1e-3; segment count by the ripple rule of `prepare`):
+Cases (steel, R_B = 10 mm, LN with cₑ = 0.9, sphere journal / sphere segments, the package's
+default time step unless --timestep-us is given, implicitfast, impedance 1e-3; segment count by the ripple rule of `prepare`):
   A. the default slider-crank joint (c = 0.5 mm), effective mass from `prepare` (qpos0),
      fitted over the default range (impact speed/50 .. impact speed), evaluated at
      0.1–5 m/s;
@@ -90,8 +90,11 @@ def _misses(rows) -> str:
     return "; ".join(out) if out else "none"
 
 
+TIMESTEP = ModelOptions().timestep  # [s]; set from --timestep-us in main
+
+
 def _case(title: str, mech, *, speeds=None, cycle: bool = False, eval_speeds=EVAL_SPEEDS) -> tuple[str, dict]:
-    opts = ModelOptions()
+    opts = ModelOptions(timestep=TIMESTEP)
     prep = prepare(mech, opts)
     j = mech.clearance_joints[0]
     s, ring = prep.sizing[j.name], prep.built.rings[j.name]
@@ -164,7 +167,7 @@ def _full_cost(nstep: int = 20000) -> str:
     from clearance.contact_calibration import ExactLNContact, step_exact_ln
     from clearance.options import ContactMode
 
-    prep = prepare(slider_crank(), ModelOptions(contact_mode=ContactMode.CALIBRATED))
+    prep = prepare(slider_crank(), ModelOptions(contact_mode=ContactMode.CALIBRATED, timestep=TIMESTEP))
     model = prep.model
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
@@ -186,8 +189,8 @@ def _full_cost(nstep: int = 20000) -> str:
     exact = nstep / (time.perf_counter() - t0)
     frac = float(np.mean(run.force[:, 0] > 0))
     return (
-        f"Whole default slider-crank (N = {prep.built.rings[j.name].segments}, 1 µs, first "
-        f"{nstep * 1e-3:.0f} ms from the initial keyframe, contact during {frac:.0%} of the steps, one "
+        f"Whole default slider-crank (N = {prep.built.rings[j.name].segments}, {TIMESTEP * 1e6:g} µs, first "
+        f"{nstep * TIMESTEP * 1e3:.0f} ms from the initial keyframe, contact during {frac:.0%} of the steps, one "
         f"thread): calibrated mode with `mujoco.rollout` {roll:,.0f} steps/s; exact-LN "
         f"`step_exact_ln` {exact:,.0f} steps/s ({roll / exact:.1f}× slower).\n"
     )
@@ -195,8 +198,12 @@ def _full_cost(nstep: int = 20000) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--timestep-us", type=float, default=ModelOptions().timestep * 1e6,
+                    help="MuJoCo time step [µs] (default: the package default)")
     ap.add_argument("--out", default=str(Path(__file__).with_suffix(".md")))
     args = ap.parse_args(argv)
+    global TIMESTEP
+    TIMESTEP = args.timestep_us * 1e-6
     t0 = time.perf_counter()
     with tempfile.TemporaryDirectory() as tmp:
         os.environ["CLEARANCE_CACHE_DIR"] = tmp
@@ -210,7 +217,8 @@ def main(argv: list[str] | None = None) -> int:
         ex = _exact(info) + "\n" + _full_cost()
     text = (
         "# Contact calibration accuracy\n\n"
-        f"Command: `python benchmarks/calibration_accuracy.py` ({time.perf_counter() - t0:.0f} s; "
+        f"Command: `python benchmarks/calibration_accuracy.py --timestep-us {args.timestep_us:g}` "
+        f"({time.perf_counter() - t0:.0f} s; time step {args.timestep_us:g} µs; "
         f"MuJoCo {mujoco.__version__}, Python {platform.python_version()}, {platform.machine()}, "
         f"{os.cpu_count()} CPUs).\n\n"
         "Calibrated mode: MuJoCo's ring of N linear rows with fitted per-row stiffness and damping "
