@@ -64,7 +64,7 @@ def main() -> None:
          DEFAULT_MAX_RATE_HZ, t_sim1 + t_ideal, len(res1)),
         ("rod_slider, mechanism at every step (max_rate_hz=None)", [LoggedRun(res1, mech1)], None, t_sim1, len(res1)),
         ("crank_rod + rod_slider", [LoggedRun(res2, mech2)], DEFAULT_MAX_RATE_HZ, t_sim2, len(res2)),
-        ("rod_slider, stored every 10 µs (result.decimated(10))", [LoggedRun(dec, mech1)], DEFAULT_MAX_RATE_HZ,
+        (f"rod_slider, every 10th step stored ({10 * res1.metadata['time_step'] * 1e6:g} µs, result.decimated(10))", [LoggedRun(dec, mech1)], DEFAULT_MAX_RATE_HZ,
          t_sim1, len(dec)),
         ("two runs under mujoco/ and reference/ prefixes (same arrays twice)",
          [LoggedRun(res1, mech1, prefix="mujoco"), LoggedRun(res1, mech1, prefix="reference")],
