@@ -193,5 +193,6 @@ def _check_time_step(name: str, s: JointSizing, h: float) -> None:
             f"omega*h = {omega * h:.2f} >= 2 at the largest expected penetration "
             f"({s.penetration_limit * 1e6:.1f} um, tangent stiffness {k_t:.3g} N/m, effective mass "
             f"{s.effective_mass:.3g} kg), so the contact would blow up. Use a time step below "
-            f"{h_max:.3g} s (largest stable), ideally below {0.1 / omega:.3g} s for accurate force peaks."
+            f"{h_max:.3g} s (largest stable for the contact spring; damping lowers it, so stay well below), "
+            f"and below {0.1 / omega:.3g} s (omega*h <= 0.1) to resolve that deepest impact's force peak exactly."
         )
