@@ -7,11 +7,13 @@ speeds; the deviation of the first output from the ideal mechanism's is measured
 drive period after the first (`statistics.per_cycle_mean_deviation`).
 
 Score of a joint: the mean over grid cells of (mean deviation / clearance), so every cell
-weighs alike whatever its clearance. Confidence: each cell's standard error comes from
-the scatter of its per-cycle values; the score's 95 % interval uses Student's t with the
-pooled degrees of freedom, and "confidence above next" is the normal probability that
-the joint's score truly exceeds the next-ranked one's, Phi((s_i - s_j) / sqrt(se_i^2 +
-se_j^2)). Cycles of one run are correlated, so these intervals are indicative.
+weighs alike whatever its clearance. Its unit follows the output's kind: dimensionless
+(m/m) for a position output, rad/m for an angle output. Confidence: each cell's standard
+error comes from the scatter of its per-cycle values; the score's 95 % interval uses
+Student's t with the pooled degrees of freedom, and "confidence above next" is the normal
+probability that the joint's score truly exceeds the next-ranked one's,
+Phi((s_i - s_j) / sqrt(se_i^2 + se_j^2)). Cycles of one run are correlated, so these
+intervals are indicative.
 """
 
 from __future__ import annotations
@@ -26,12 +28,14 @@ import numpy as np
 from scipy import stats
 
 from clearance.analysis.sweep import SweepEvaluation, run_sweep
+from clearance.model import OutputKind
 
 __all__ = [
     "CellDeviation",
     "ClearanceAtJoint",
     "CriticalityRanking",
     "JointScore",
+    "NothingToRankError",
     "criticality_candidates",
     "criticality_points",
     "rank_joints",
@@ -70,7 +74,8 @@ class ClearanceAtJoint:
     Attributes:
         builder: module-level builder function.
         fixed: other keyword arguments.
-        joint_key, clearance_key, speed_key: the builder's keyword names.
+        joint_key, clearance_key, speed_key: the builder's keyword names (the press's speed
+            keyword is ``crank2_speed``: see `CatalogueEntry.speed_keyword`).
     """
 
     builder: Callable[..., Any]
@@ -129,9 +134,10 @@ class JointScore:
     Attributes:
         joint: joint name.
         rank: overall rank (1 = most critical).
-        score: mean over cells of mean deviation / clearance [-].
-        se: standard error of the score [-].
-        ci_low, ci_high: 95 % interval of the score [-].
+        score: mean over cells of mean deviation / clearance [output unit / m: 1 for a
+            position output, rad/m for an angle output; see `CriticalityRanking.score_unit`].
+        se: standard error of the score [same unit].
+        ci_low, ci_high: 95 % interval of the score [same unit].
         cells: number of cells that ran.
         mean_cell_rank: mean of the per-cell ranks.
         confidence_above_next: probability the score exceeds the next joint's (NaN for the
@@ -157,23 +163,57 @@ class CriticalityRanking:
         scores: `JointScore` in rank order.
         cells: `CellDeviation` rows.
         failed: (point, error) of points that did not run.
+        output: name of the measured output ('' when not known).
+        output_kind: its `OutputKind` (None when not known); sets the units.
     """
 
     scores: tuple[JointScore, ...]
     cells: tuple[CellDeviation, ...]
     failed: tuple[tuple[dict[str, Any], str], ...] = ()
+    output: str = ""
+    output_kind: OutputKind | None = None
+
+    @property
+    def score_unit(self) -> str:
+        """Unit of the scores: ``-`` (m/m) for a position output, ``rad/m`` for an angle output."""
+        if self.output_kind is None:
+            return "output unit/m"
+        return "rad/m" if self.output_kind is OutputKind.ANGLE else "-"
+
+    @property
+    def deviation_unit(self) -> str:
+        """Unit in which `ranking_markdown` shows the cells' mean deviations (µm or µrad)."""
+        if self.output_kind is None:
+            return "µm or µrad"
+        return "µrad" if self.output_kind is OutputKind.ANGLE else "µm"
 
 
-def rank_joints(rows: Sequence[Mapping[str, Any]]) -> CriticalityRanking:
+class NothingToRankError(ValueError):
+    """No criticality point ran; ``failed`` holds (point, error) of every point that failed."""
+
+    def __init__(self, message: str, failed: tuple[tuple[dict[str, Any], str], ...]) -> None:
+        super().__init__(message)
+        self.failed = failed
+
+
+def rank_joints(
+    rows: Sequence[Mapping[str, Any]], *, output: str = "", output_kind: OutputKind | None = None
+) -> CriticalityRanking:
     """Rank joints from criticality sweep rows (see the module docstring).
 
+    Args:
+        rows: criticality sweep rows (`run_sweep` output or `load_rows`).
+        output: name of the measured output, recorded in the ranking.
+        output_kind: its kind, which sets the score unit (None: unknown).
+
     Raises:
-        ValueError: no row ran.
+        NothingToRankError: no row ran (a `ValueError`).
     """
     ok = [r for r in rows if r["status"] == "ok" and r.get("per_cycle_mean_deviation")]
     failed = tuple((dict(r["point"]), r.get("error", "")) for r in rows if r not in ok)
     if not ok:
-        raise ValueError("no criticality point ran: nothing to rank")
+        first = f"; first error: {failed[0][1]}" if failed else ""
+        raise NothingToRankError(f"no criticality point ran ({len(failed)} failed{first}): nothing to rank", failed)
     raw = []
     for r in ok:
         v = np.asarray(r["per_cycle_mean_deviation"], float)
@@ -205,20 +245,22 @@ def rank_joints(rows: Sequence[Mapping[str, Any]]) -> CriticalityRanking:
         else:
             conf = float("nan")
         scores.append(JointScore(x[0], i + 1, x[1], x[2], x[3], x[4], x[5], x[6], conf))
-    return CriticalityRanking(tuple(scores), tuple(cells), failed)
+    return CriticalityRanking(tuple(scores), tuple(cells), failed, output, output_kind)
 
 
 def ranking_markdown(ranking: CriticalityRanking) -> str:
     """Markdown tables: the ranking, then the per-cell mean deviations."""
+    unit = ranking.score_unit
     lines = [
-        "| rank | joint | score (mean dev. / c) | 95 % interval | cells | mean cell rank | P(above next) |",
+        f"| rank | joint | score (mean dev. / c) [{unit}] | 95 % interval | cells | mean cell rank | P(above next) |",
         "|---:|---|---:|---|---:|---:|---:|",
     ]
     for s in ranking.scores:
         conf = "" if not np.isfinite(s.confidence_above_next) else f"{s.confidence_above_next:.3f}"
         lines.append(f"| {s.rank} | {s.joint} | {s.score:.4g} | [{s.ci_low:.4g}, {s.ci_high:.4g}] | {s.cells} "
                      f"| {s.mean_cell_rank:.2f} | {conf} |")
-    lines += ["", "| joint | clearance [mm] | speed [rpm] | mean deviation [µm or µrad] | s.e. | cycles | rank in cell |",
+    lines += ["", f"| joint | clearance [mm] | speed [rpm] | mean deviation [{ranking.deviation_unit}] | s.e. | cycles "
+              "| rank in cell |",
               "|---|---:|---:|---:|---:|---:|---:|"]
     for c in ranking.cells:
         lines.append(f"| {c.joint} | {c.clearance * 1e3:.4g} | {c.speed * 30 / np.pi:.4g} | "
@@ -249,7 +291,8 @@ def run_criticality(
     Args:
         make_mechanism: picklable point -> Mechanism for points ``{"joint", "clearance",
             "speed"}`` (e.g. `ClearanceAtJoint`); ``joint`` None must give the ideal
-            mechanism (used to find the candidates when ``joints`` is None).
+            mechanism (built once here to find the output's kind, and the candidates when
+            ``joints`` is None).
         clearances: radial clearances [m].
         speeds: drive speeds [rad/s].
         out_dir: sweep folder.
@@ -261,7 +304,9 @@ def run_criticality(
             `run_sweep`.
 
     Raises:
-        ValueError: empty grid or fewer than 3 periods.
+        ValueError: empty grid, fewer than 3 periods, an output the mechanism does not
+            have, or out_dir holding another sweep.
+        NothingToRankError: no point ran (a `ValueError`).
     """
     from clearance.simulation import default_duration
 
@@ -269,8 +314,13 @@ def run_criticality(
         raise ValueError("clearances and speeds must not be empty")
     if not isinstance(periods, int) or periods < 3:
         raise ValueError(f"periods must be an integer >= 3 (got {periods!r})")
+    probe = make_mechanism({"joint": None, "clearance": clearances[0], "speed": speeds[0]})
+    kinds = {o.name: o.kind for o in probe.outputs}
+    measured = output or next(iter(kinds), None)
+    if measured not in kinds:
+        raise ValueError(f"output must be one of the outputs of mechanism '{probe.name}', {list(kinds)} (got {output!r})")
     if joints is None:
-        joints = criticality_candidates(make_mechanism({"joint": None, "clearance": clearances[0], "speed": speeds[0]}))
+        joints = criticality_candidates(probe)
     points = criticality_points(joints, clearances, speeds)
     out = run_sweep(
         points,
@@ -285,4 +335,4 @@ def run_criticality(
         evaluation=SweepEvaluation(output=output, ideal=True),
         max_workers=max_workers,
     )
-    return rank_joints(out.rows)
+    return rank_joints(out.rows, output=measured, output_kind=kinds[measured])

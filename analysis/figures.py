@@ -239,14 +239,19 @@ def plot_bifurcation(diagram: BifurcationDiagram, *, path: str | Path | None = N
 
 
 def plot_criticality(ranking: CriticalityRanking, *, path: str | Path | None = None) -> plt.Figure:
-    """Bar chart of joint scores (mean deviation / clearance) with 95 % intervals."""
+    """Bar chart of joint scores (mean deviation / clearance) with 95 % intervals.
+
+    The axis unit follows the ranking's output kind (`CriticalityRanking.score_unit`): [-]
+    for a position output, [rad/m] for an angle output.
+    """
     s = ranking.scores
     fig, ax = plt.subplots(figsize=(max(5, 1.4 * len(s) + 2), 4))
     x = np.arange(len(s))
     err = np.array([[j.score - j.ci_low for j in s], [j.ci_high - j.score for j in s]])
     ax.bar(x, [j.score for j in s], yerr=err, capsize=4, color="C1", label="score, 95 % interval")
     ax.set_xticks(x, [f"{j.rank}. {j.joint}" for j in s])
-    ax.set_ylabel("mean deviation / radial clearance [-]")
+    what = f"mean deviation of {ranking.output}" if ranking.output else "mean deviation"
+    ax.set_ylabel(f"{what} / radial clearance [{ranking.score_unit}]")
     ax.set_xlabel("joint with clearance (most critical first)")
     ax.set_title("clearance-joint criticality (one joint at a time)")
     ax.legend(fontsize=8)

@@ -147,6 +147,8 @@ def write_report(
     lines += ["## Phase portraits and Poincaré sections", ""]
     sections = [(output, f"{output}_vel")] + [(f"{j}.ex", f"{j}.ey") for j in result.joints]
     lines += ["| section | points | regime | period | divergence | correlation dim. |", "|---|---:|---|---:|---:|---:|"]
+    # figures written by this call only: an earlier report in the same folder may have left others
+    phase_pngs, poincare_pngs = [], []
     for k, names in enumerate(sections):
         pts = _section(result, list(names), period, skip)
         if len(pts) == 0:
@@ -159,13 +161,14 @@ def write_report(
                      f"{cl.divergence:.3g} | {cl.correlation_dimension:.3g} |")
         if names[1].endswith("_vel"):
             figures.plot_phase_portrait(phase_portrait(result, names[0]), section=pts, path=out / f"phase_{k}.png")
+            phase_pngs.append((k, f"phase_{k}.png"))
         else:
             figures.plot_poincare(pts, names, cl, trajectory=vals, path=out / f"poincare_{k}.png")
+            poincare_pngs.append((k, f"poincare_{k}.png"))
     lines += ["", "Regime criterion: `clearance.analysis.chaos` (distinct points within 1 % of the motion's RMS "
               "size, then nearest-neighbour divergence of the section map). Few periods give few points: the "
               "regime of a short run is indicative only.", ""]
-    lines += [f"![section {k}]({p.name})" for k, p in enumerate(sorted(out.glob("phase_*.png")) +
-                                                               sorted(out.glob("poincare_*.png")))]
+    lines += [f"![section {k}]({name})" for k, name in phase_pngs + poincare_pngs]
     lines.append("")
 
     if bifurcation is not None:

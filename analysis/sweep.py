@@ -250,15 +250,30 @@ def load_rows(out_dir: str | Path) -> list[dict[str, Any]]:
 
 
 def _describe(obj: Any) -> str:
-    """A description stable across processes (no memory addresses) for the manifest."""
+    """A description stable across processes (no memory addresses) for the manifest.
+
+    Functions are named by module and qualified name; partials and dataclass instances
+    (`KeywordFactory`, `SweepEvaluation`, ...) are described field by field, so two
+    factories around different builders never describe alike. Plain values use ``repr``.
+    """
+    import dataclasses
     import functools
 
     if isinstance(obj, functools.partial):
         args = ", ".join([*(repr(a) for a in obj.args), *(f"{k}={v!r}" for k, v in sorted(obj.keywords.items()))])
         return f"partial({_describe(obj.func)}, {args})"
-    if callable(obj) and hasattr(obj, "__qualname__") and not hasattr(obj, "__dataclass_fields__"):
+    if dataclasses.is_dataclass(obj) and not isinstance(obj, type):
+        fields = ", ".join(f"{f.name}={_describe(getattr(obj, f.name))}" for f in dataclasses.fields(obj) if f.repr)
+        return f"{type(obj).__qualname__}({fields})"
+    if isinstance(obj, Mapping):
+        return "{" + ", ".join(f"{k!r}: {_describe(v)}" for k, v in obj.items()) + "}"
+    if callable(obj) and hasattr(obj, "__qualname__"):
         return f"{getattr(obj, '__module__', '?')}.{obj.__qualname__}"
     return repr(obj)
+
+
+_SETTING_NAMES = {"mechanism": "mechanism factory", "duration": "duration", "options": "model options",
+                  "evaluation": "evaluation"}
 
 
 def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str, Any]) -> None:
@@ -267,8 +282,13 @@ def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str,
     if path.exists():
         old = json.loads(path.read_text())
         if old != manifest:
+            old_settings = old.get("settings", {})
+            diffs = [f"{_SETTING_NAMES.get(k, k)}: {old_settings.get(k, '(not recorded)')!r} there, {v!r} now"
+                     for k, v in manifest["settings"].items() if old_settings.get(k) != v]
+            if old.get("points") != manifest["points"]:
+                diffs.insert(0, f"points: {len(old.get('points', []))} there, {len(points)} now or values differ")
             raise ValueError(
-                f"{out} holds a different sweep (points or settings differ from {path}); "
+                f"{out} holds a different sweep ({'; '.join(diffs) or 'manifest differs'}; see {path}); "
                 "use another out_dir or delete that folder"
             )
     else:
@@ -301,8 +321,9 @@ def run_sweep(
         executor: executor to use (not shut down here).
         scheduler_address: Dask scheduler address; its client's executor is used.
         progress: show a tqdm progress bar (points done, rate, time remaining).
-        stop_after: stop after this many points finished in this call (the rest resume
-            on the next call).
+        stop_after: stop submitting points once this many have finished in this call;
+            points already running then are waited for and written too, so no computed
+            point is lost (the rest resume on the next call).
         evaluation: picklable callable (result, ideal result or None, mechanism) -> row
             fields; default `SweepEvaluation()`. It gets the ideal run when its attribute
             ``ideal`` is true (or absent).
@@ -312,7 +333,8 @@ def run_sweep(
         `SweepOutcome`.
 
     Raises:
-        ValueError: empty points, a bad stop_after, or out_dir holding another sweep.
+        ValueError: empty points, a bad stop_after, or out_dir holding another sweep
+            (other points, mechanism factory, duration, options or evaluation).
     """
     pts = [dict(p) for p in points]
     if not pts:
@@ -323,7 +345,8 @@ def run_sweep(
     needs_ideal = bool(getattr(evaluation, "ideal", True))
     out = Path(out_dir)
     (out / "points").mkdir(parents=True, exist_ok=True)
-    settings = {"duration": _describe(duration), "options": repr(options), "evaluation": _describe(evaluation)}
+    settings = {"mechanism": _describe(make_mechanism), "duration": _describe(duration), "options": repr(options),
+                "evaluation": _describe(evaluation)}
     _check_manifest(out, _json_safe(pts), settings)
     rows = {r["index"]: r for r in load_rows(out) if 0 <= r["index"] < len(pts)}
     todo = [i for i in range(len(pts)) if i not in rows]
@@ -337,7 +360,7 @@ def run_sweep(
         executor = client.get_executor()
     elif executor is None:
         executor = ProcessPoolExecutor(max_workers=max_workers, mp_context=multiprocessing.get_context("spawn"))
-    # points in flight: twice the workers, so workers never wait and a stop wastes little
+    # points in flight: twice the workers, so workers never wait
     slots = max_workers or getattr(executor, "_max_workers", None) or os.cpu_count() or 1
     if client is not None:
         slots = max(1, sum(client.nthreads().values()))
@@ -345,10 +368,19 @@ def run_sweep(
     bar = _bar(progress, len(pts), len(rows))
     in_flight: dict[Any, int] = {}
     queue = iter(todo)
-    new, stopped = 0, False
+    new = 0
+
+    def save(i: int, row: dict[str, Any]) -> None:
+        nonlocal new
+        atomic_write_text(out / "points" / f"point_{i:06d}.json", json.dumps(row, indent=1))
+        rows[i] = row
+        atomic_write_text(csv_path, _csv_text([rows[k] for k in sorted(rows)]))
+        new += 1
+        bar(1)
+
     try:
         while True:
-            while not stopped and len(in_flight) < window:
+            while len(in_flight) < window:
                 i = next(queue, None)
                 if i is None:
                     break
@@ -357,21 +389,16 @@ def run_sweep(
             if not in_flight:
                 break
             finished, _ = wait(list(in_flight), return_when=FIRST_COMPLETED)
+            # every finished point is written, also those finishing together with the stop
             for fut in sorted(finished, key=in_flight.__getitem__):
-                i = in_flight.pop(fut)
-                if stopped:
-                    continue
-                row = fut.result()
-                atomic_write_text(out / "points" / f"point_{i:06d}.json", json.dumps(row, indent=1))
-                rows[i] = row
-                atomic_write_text(csv_path, _csv_text([rows[k] for k in sorted(rows)]))
-                new += 1
-                bar(1)
-                if stop_after is not None and new >= stop_after:
-                    stopped = True
-            if stopped:
-                for fut in in_flight:
-                    fut.cancel()
+                save(in_flight.pop(fut), fut.result())
+            if stop_after is not None and new >= stop_after:
+                # points that already started cannot be cancelled: wait for them and write them
+                running = [f for f in in_flight if not f.cancel()]
+                wait(running)
+                for fut in sorted(running, key=in_flight.__getitem__):
+                    save(in_flight[fut], fut.result())
+                in_flight.clear()
                 break
     finally:
         bar(None)

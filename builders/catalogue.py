@@ -2,13 +2,15 @@
 
 `CATALOGUE` maps each name to a `CatalogueEntry` (builder, family, `LinkageInfo`: topology,
 driven joints, output pivot, clearable joints, the joints of a criticality ranking, where
-transmission angles are measured, provenance of the dimensions). `check_linkage` follows a
+transmission angles are measured, provenance of the dimensions; the builder's drive-speed
+keyword and the speed range a sweep covers by default). `check_linkage` follows a
 mechanism over whole drive cycles with the generic kinematics solver and reports the
 transmission-angle ranges and the distance from singular positions.
 """
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from types import MappingProxyType
@@ -20,7 +22,7 @@ from clearance.builders._linkage import LinkageInfo
 from clearance.builders.four_bar import FOUR_BAR_INFO, four_bar
 from clearance.builders.multiloop import EIGHT_BAR_INFO, TEN_BAR_INFO, eight_bar, ten_bar
 from clearance.builders.press import PRESS_INFO, seven_bar_press
-from clearance.builders.slider_crank import slider_crank
+from clearance.builders.slider_crank import rpm, slider_crank
 from clearance.builders.stephenson import (
     STEPHENSON_I_INFO,
     STEPHENSON_I_SLIDER_INFO,
@@ -42,7 +44,8 @@ from clearance.builders.watt import (
 from clearance.kinematics import TransmissionAngle, solve_kinematics, transmission_angle
 from clearance.model import DriveKind, Mechanism
 
-__all__ = ["CatalogueEntry", "CATALOGUE", "SLIDER_CRANK_INFO", "names", "get", "build", "LinkageCheck", "check_linkage"]
+__all__ = ["CatalogueEntry", "CATALOGUE", "CRANK_SPEED_RANGE", "PRESS_SPEED_RANGE", "SLIDER_CRANK_INFO", "names",
+           "get", "build", "LinkageCheck", "check_linkage"]
 
 SLIDER_CRANK_INFO = LinkageInfo(
     topology="In-line slider-crank: ground (crank_pivot, guide), crank (driven), rod, slider "
@@ -55,6 +58,13 @@ SLIDER_CRANK_INFO = LinkageInfo(
 )
 
 
+CRANK_SPEED_RANGE = (rpm(1000.0), rpm(5000.0))
+"""Default speed range of the crank-driven mechanisms' sweeps [rad/s]: 1000-5000 rpm."""
+
+PRESS_SPEED_RANGE = (math.pi, 3 * math.pi)
+"""Default speed range of the press's sweeps [rad/s]: the seed's 1-3 pi rad/s (see `seven_bar_press`)."""
+
+
 @dataclass(frozen=True)
 class CatalogueEntry:
     """One mechanism of the catalogue.
@@ -64,12 +74,25 @@ class CatalogueEntry:
         builder: keyword-only callable returning the `Mechanism`.
         family: slider-crank, four-bar, Watt six-bar, Stephenson six-bar, multi-loop or press.
         info: topology, joints and provenance (see `LinkageInfo`).
+        speed_keyword: the builder's keyword for the speed of its (first) constant-speed
+            drive [rad/s] (``crank_speed``; ``crank2_speed`` for the press).
+        speed_range: (low, high) drive speeds a sweep covers by default [rad/s]; a
+            clearance sweep holds the high one, a criticality grid uses the low one and
+            the middle.
     """
 
     name: str
     builder: Callable[..., Mechanism]
     family: str
     info: LinkageInfo
+    speed_keyword: str = "crank_speed"
+    speed_range: tuple[float, float] = CRANK_SPEED_RANGE
+
+    def __post_init__(self) -> None:
+        lo, hi = self.speed_range
+        if not (0 < lo <= hi < math.inf):
+            raise ValueError(f"catalogue entry '{self.name}' speed_range must satisfy 0 < low <= high "
+                             f"(got {self.speed_range!r} rad/s)")
 
 
 CATALOGUE: Mapping[str, CatalogueEntry] = MappingProxyType({
@@ -85,7 +108,8 @@ CATALOGUE: Mapping[str, CatalogueEntry] = MappingProxyType({
         CatalogueEntry("stephenson_ii_2", stephenson_ii_2, "Stephenson six-bar", STEPHENSON_II_2_INFO),
         CatalogueEntry("eight_bar", eight_bar, "multi-loop", EIGHT_BAR_INFO),
         CatalogueEntry("ten_bar", ten_bar, "multi-loop", TEN_BAR_INFO),
-        CatalogueEntry("seven_bar_press", seven_bar_press, "press", PRESS_INFO),
+        CatalogueEntry("seven_bar_press", seven_bar_press, "press", PRESS_INFO, speed_keyword="crank2_speed",
+                       speed_range=PRESS_SPEED_RANGE),
     )
 })
 """Every catalogue mechanism by name, in catalogue order."""

@@ -76,7 +76,8 @@ def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, cont
                    help="joints with clearance (default: the builder's, rod_slider for the slider-crank); "
                         "give none for the ideal mechanism")
     g.add_argument("--rpm", type=positive(float, "--rpm"), default=None,
-                   help="crank speed [rpm] (default: the builder's; 5000 for the slider-crank)")
+                   help="speed of the driven crank [rpm] (the press: crank 2; default: the builder's, "
+                        "5000 for the slider-crank)")
     g.add_argument("--gravity", action="store_true", help="gravity 9.81 m/s² along -y")
     if numerics:
         add_numerics_args(p, contact_mode=contact_mode)
@@ -130,12 +131,13 @@ def mechanism_from_args(args: argparse.Namespace):
         if given:
             raise ValueError(f"{', '.join(given)}: give these in the scenario file {args.scenario}, not with --scenario")
         return load_scenario(args.scenario)
-    builder = CATALOGUE[args.mechanism].builder
+    entry = CATALOGUE[args.mechanism]
+    builder, speed = entry.builder, entry.speed_keyword
     accepted = inspect.signature(builder).parameters
     kw, flags = {}, {}
     for flag, key, value in (("--clearance-mm", "radial_clearance", args.clearance_mm),
                              ("--clearance-at", "clearance_at", args.clearance_at),
-                             ("--rpm", "crank_speed", args.rpm), ("--gravity", "gravity", args.gravity or None)):
+                             ("--rpm", speed, args.rpm), ("--gravity", "gravity", args.gravity or None)):
         if value is not None:
             flags[key] = flag
     if args.clearance_mm is not None:
@@ -143,7 +145,7 @@ def mechanism_from_args(args: argparse.Namespace):
     if args.clearance_at is not None:
         kw["clearance_at"] = tuple(args.clearance_at)
     if args.rpm is not None:
-        kw["crank_speed"] = rpm(args.rpm)
+        kw[speed] = rpm(args.rpm)
     if args.gravity:
         kw["gravity"] = 9.81
     refused = [flags[k] for k in kw if k not in accepted]

@@ -1,4 +1,4 @@
-"""Sweeps: resume after an injected stop, process pool against Dask, row contents."""
+"""Sweeps: resume after an injected stop, process pool against Dask, row contents, manifest guard."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import json
 import pytest
 
 from clearance.analysis.sweep import KeywordFactory, SweepEvaluation, load_rows, run_sweep
-from clearance.builders import rpm, slider_crank
+from clearance.builders import four_bar, rpm, slider_crank
 from clearance.options import ModelOptions
 from clearance.simulation import default_duration
 
@@ -48,11 +48,14 @@ def test_rows_hold_statistics_summary_and_poincare(full):
 
 
 def test_resumed_sweep_equals_uninterrupted(full, tmp_path):
-    part = _sweep(tmp_path, stop_after=2)
-    assert not part.complete and part.new == 2
-    assert len(list((tmp_path / "points").glob("*.json"))) == 2
+    # one worker keeps two points in flight; the stop after the first also writes the
+    # second if it had started, and submits no more
+    part = run_sweep(POINTS, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False,
+                     max_workers=1, stop_after=1)
+    assert not part.complete and part.new in (1, 2)
+    assert len(list((tmp_path / "points").glob("*.json"))) == part.new
     rest = _sweep(tmp_path)
-    assert rest.complete and rest.new == 2
+    assert rest.complete and rest.new == 4 - part.new
     # same thread count (one MuJoCo thread per run): bitwise-equal table
     assert rest.csv_path.read_bytes() == full.csv_path.read_bytes()
     # a finished sweep run again computes nothing; the manifest that guards resumption is
@@ -82,6 +85,33 @@ def test_errors_are_rows_and_other_sweeps_are_refused(tmp_path):
                   executor=_Inline())
     with pytest.raises(ValueError, match="stop_after"):
         run_sweep(POINTS, MAKE, out_dir=tmp_path / "x", stop_after=0, executor=_Inline())
+
+
+BAD = [{"radial_clearance": c, "rod_length": 0.01} for c in (0.1e-3, 0.2e-3, 0.3e-3)]  # rod shorter than crank
+
+
+def test_points_finishing_with_the_stop_are_written(tmp_path):
+    # the inline executor finishes all three points before the first wait: they come back
+    # in one batch, and the stop after the first must not drop the other two
+    out = run_sweep(BAD, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False,
+                    executor=_Inline(), max_workers=3, stop_after=1, evaluation=SweepEvaluation(ideal=False))
+    assert out.new == 3 and out.complete
+    assert [r["index"] for r in load_rows(tmp_path)] == [0, 1, 2]
+
+
+def test_resume_with_another_mechanism_factory_is_refused(tmp_path):
+    kw = dict(out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False, executor=_Inline(),
+              evaluation=SweepEvaluation(ideal=False))
+    assert run_sweep(BAD, MAKE, **kw).new == 3
+    other_builder = KeywordFactory(four_bar, fixed={"crank_speed": rpm(1000.0)})
+    other_speed = KeywordFactory(slider_crank, fixed={"crank_speed": rpm(2000.0)})
+    for make in (other_builder, other_speed):
+        with pytest.raises(ValueError, match="mechanism factory") as err:
+            run_sweep(BAD, make, **kw)
+        assert "use another out_dir" in str(err.value)
+    assert run_sweep(BAD, MAKE, **kw).new == 0  # the same factory resumes
+    manifest = json.loads((tmp_path / "sweep.json").read_text())
+    assert "slider_crank" in manifest["settings"]["mechanism"] and " at 0x" not in manifest["settings"]["mechanism"]
 
 
 class _Inline:

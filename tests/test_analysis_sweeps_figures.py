@@ -18,6 +18,7 @@ from clearance.analysis.criticality import (
 )
 from clearance.analysis.sweep import KeywordFactory
 from clearance.builders import rpm, slider_crank
+from clearance.model import OutputKind
 from clearance.options import ModelOptions
 
 # low speed and a coarse step keep each run well under a second (1000 rpm: T = 60 ms)
@@ -77,12 +78,31 @@ def test_criticality_candidates_and_sweep(tmp_path):
         assert 0 < s.score < 1.1
         assert s.ci_low <= s.score <= s.ci_high
     assert len(r.cells) == 2 and all(c.cycles == 2 for c in r.cells)
+    # the slider's x position is measured: deviation [m] / clearance [m] is dimensionless
+    assert (r.output, r.output_kind, r.score_unit) == ("slider_x", OutputKind.POSITION_X, "-")
     md = ranking_markdown(r)
-    assert "| 1 |" in md and "rod_slider" in md
+    assert "| 1 |" in md and "rod_slider" in md and "[-]" in md and "[µm]" in md
     from clearance.analysis.figures import plot_criticality
 
-    plot_criticality(r, path=tmp_path / "crit.png")
+    fig = plot_criticality(r, path=tmp_path / "crit.png")
+    assert fig.axes[0].get_ylabel() == "mean deviation of slider_x / radial clearance [-]"
     assert (tmp_path / "crit.png").stat().st_size > 5000
+    with pytest.raises(ValueError, match="output must be one of .*slider_x"):
+        run_criticality(ClearanceAtJoint(slider_crank), clearances=[0.5e-3], speeds=[rpm(1000.0)], periods=3,
+                        output="crank_angle", out_dir=tmp_path / "x", executor=_Inline(), progress=False)
+
+
+def test_score_unit_follows_the_output_kind():
+    from clearance.analysis.figures import plot_criticality
+
+    rows = [_row(0, "a", 1e-4, [0.5e-4, 0.6e-4]), _row(1, "b", 1e-4, [0.2e-4, 0.3e-4])]
+    angle = rank_joints(rows, output="rocker_angle", output_kind=OutputKind.ANGLE)
+    assert angle.score_unit == "rad/m"  # deviation [rad] / clearance [m]
+    assert "[rad/m]" in ranking_markdown(angle) and "[µrad]" in ranking_markdown(angle)
+    assert plot_criticality(angle).axes[0].get_ylabel().endswith("[rad/m]")
+    assert rank_joints(rows, output_kind=OutputKind.POSITION_Y).score_unit == "-"
+    unknown = rank_joints(rows)  # rows alone do not say what was measured
+    assert unknown.output_kind is None and "[-]" not in plot_criticality(unknown).axes[0].get_ylabel()
 
 
 def _row(i, joint, c, cycles):
@@ -108,7 +128,7 @@ def test_rank_joints_scores_and_confidence():
     assert a.confidence_above_next > 0.99  # 0.3 apart with s.e. ~0.04 each
     assert np.isnan(b.confidence_above_next)
     assert r.failed and r.failed[0][1] == "boom"
-    with pytest.raises(ValueError, match="nothing to rank"):
+    with pytest.raises(ValueError, match="1 failed; first error: boom"):
         rank_joints(rows[4:])
 
 
@@ -121,14 +141,19 @@ def test_report_writes_markdown_and_figures(tmp_path):
     diag = BifurcationDiagram("radial_clearance", "rod_slider.ex", np.array([1e-4, 2e-4]),
                               (np.array([1e-5, 2e-5]), np.zeros(0)), ("periodic", "error"), ("", "boom"))
     ranking = rank_joints([_row(0, "a", 1e-4, [0.5e-4, 0.6e-4]), _row(1, "b", 1e-4, [0.2e-4, 0.3e-4])])
+    # figures of an earlier report into the same folder (a mechanism with more joints)
+    for stale in ("phase_4.png", "poincare_2.png"):
+        (tmp_path / stale).write_bytes(b"")
     path = write_report(tmp_path, res, ideal, bifurcation=diag, ranking=ranking)
     text = path.read_text()
     for heading in ("Response against the ideal", "Deviation statistics", "Contact at the clearance joints",
                     "Poincaré sections", "Bifurcation diagram", "Joint criticality"):
         assert heading in text
     for png in ("response_vs_ideal", "deviation", "contact_force", "contact_modes", "orbit_rod_slider",
-                "phase_0", "bifurcation", "criticality"):
+                "phase_0", "poincare_1", "bifurcation", "criticality"):
         assert (tmp_path / f"{png}.png").exists() and f"({png}.png)" in text
+    # sections: the output's phase portrait and rod_slider's eccentricity, nothing older
+    assert "phase_4.png" not in text and "poincare_2.png" not in text
 
 
 def test_cli_sweep_and_rank(tmp_path, capsys):
@@ -142,6 +167,40 @@ def test_cli_sweep_and_rank(tmp_path, capsys):
     assert "rod_slider" in capsys.readouterr().out
     with pytest.raises(SystemExit):
         main_sweep(["--mechanism", "no_such", "--out", str(tmp_path / "x")])
+
+
+def test_cli_refuses_unknown_quantity_and_reports_failed_points(tmp_path, capsys):
+    common = ["--workers", "1", "--no-progress", "--periods", "2", "--sampled", "1"]
+    assert main_sweep(["--quantity", "no_such", "--out", str(tmp_path / "q"), *common]) == 2
+    err = capsys.readouterr().err
+    assert "--quantity 'no_such'" in err and "'rod_slider.ex'" in err and "'slider_x_vel'" in err
+    assert not (tmp_path / "q").exists()  # refused before any point was launched
+    # a 1 ms step is far above the contact's stability limit (about 10 us here): every
+    # point fails at its time-step check, in milliseconds
+    rc = main_sweep(["--timestep-us", "1000", "--points", "2", "--out", str(tmp_path / "f"), *common])
+    err = capsys.readouterr().err
+    assert rc == 1 and "2 of 2 points failed" in err and "TimeStepError" in err and "sweep.csv" in err
+    rc = main_rank(["--timestep-us", "1000", "--clearances-mm", "0.5", "--rpm", "1000", "--joints", "rod_slider",
+                    "--periods", "3", "--workers", "1", "--no-progress", "--out", str(tmp_path / "r")])
+    assert rc == 1 and "1 of 1 points failed" in capsys.readouterr().err
+    assert main_rank(["--joints", "no_such", "--out", str(tmp_path / "j")]) == 2
+    assert "['crank_rod', 'rod_slider']" in capsys.readouterr().err
+
+
+def test_cli_sweeps_and_ranks_the_press(tmp_path, monkeypatch, capsys):
+    """The press's speed keyword is crank2_speed; one short point each (about 4 s)."""
+    monkeypatch.chdir(tmp_path)
+    # 90 rpm = 3 pi rad/s (T = 0.67 s), the top of the press's speed range; 10 us steps
+    common = ["--mechanism", "seven_bar_press", "--rpm", "90", "--timestep-us", "10", "--segments", "36",
+              "--workers", "1", "--no-progress"]
+    rc = main_sweep(["--points", "1", "--start", "0.5", "--stop", "0.5", "--periods", "2", "--sampled", "1", *common])
+    out = tmp_path / "clearance-sweep-seven_bar_press"  # default folder named after the mechanism
+    assert rc == 0 and (out / "bifurcation.png").exists(), capsys.readouterr().err
+    rc = main_rank(["--clearances-mm", "0.5", "--joints", "A", "--periods", "3", *common])
+    ranking = (tmp_path / "clearance-rank-seven_bar_press" / "ranking.md").read_text()
+    assert rc == 0 and "| 1 | A |" in ranking and "[-]" in ranking  # slider_y: a position output
+    assert main_sweep(["--clearance-at", "Z", *common]) == 2
+    assert "unknown joint" in capsys.readouterr().err
 
 
 @pytest.mark.parametrize("module", ["statistics", "response", "chaos", "sweep", "bifurcation", "criticality",
@@ -163,3 +222,14 @@ def test_every_public_argument_is_documented(module):
         # Args section only where a function takes more than two arguments
         if len(inspect.signature(obj).parameters) > 2:
             assert not missing, f"{module}.{name}: undocumented {missing}"
+
+
+def test_catalogue_speed_keyword_sets_the_first_drive_speed():
+    """The CLI passes each entry's speed keyword to its builder: every builder must take it."""
+    from clearance.builders import CATALOGUE
+
+    for name, entry in CATALOGUE.items():
+        low, high = entry.speed_range
+        m = entry.builder(**{entry.speed_keyword: high})
+        # the value is stored as given: exact
+        assert m.drives[0].speed == high and 0 < low < high, name
