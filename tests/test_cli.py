@@ -63,9 +63,26 @@ def test_catalogue_mechanism_and_scenario_file(tmp_path):
     assert main(["mjcf", "--scenario", str(toml), "--segments", "36", "--out", str(path)]) == 0
 
 
-def test_option_the_builder_lacks_is_refused(capsys):
-    assert main(["mjcf", "--mechanism", "seven_bar_press", "--rpm", "100"]) == 2
-    assert "does not take" in capsys.readouterr().err
+def test_rpm_sets_the_catalogue_mechanisms_driven_crank(tmp_path, monkeypatch):
+    """--rpm goes to the builder's own speed keyword (the press: crank 2, not 'crank_speed')."""
+    import math
+
+    from clearance import cli_options
+    from clearance.builders import CATALOGUE
+
+    built = []
+    real = cli_options.mechanism_from_args
+
+    def keep(args):
+        built.append(real(args))
+        return built[-1]
+
+    monkeypatch.setattr("clearance.cli._mechanism", keep)
+    path = tmp_path / "press.xml"
+    assert main(["mjcf", "--mechanism", "seven_bar_press", "--rpm", "45", "--segments", "36", "--out", str(path)]) == 0
+    assert CATALOGUE["seven_bar_press"].speed_keyword == "crank2_speed"
+    drive = built[0].drives[0]
+    assert drive.speed == pytest.approx(45 * 2 * math.pi / 60, rel=1e-12)  # exact unit conversion
 
 
 def test_run_contact_mode_option(tmp_path, capsys):
