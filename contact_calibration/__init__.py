@@ -30,7 +30,9 @@ from clearance.contact_calibration.impact import (
     simulate_oblique_impact,
 )
 from clearance.contact_calibration.laws import (
+    MIN_APPROACH_SPEED,
     STIFFNESS_FORMULA,
+    UnverifiedLawWarning,
     ambrosio_friction,
     bearing_stiffness,
     bearing_stiffness_from,
@@ -107,7 +109,9 @@ __all__ = [
     "law_impact",
     "simulate_impact",
     "simulate_oblique_impact",
+    "MIN_APPROACH_SPEED",
     "STIFFNESS_FORMULA",
+    "UnverifiedLawWarning",
     "ambrosio_friction",
     "bearing_stiffness",
     "bearing_stiffness_from",

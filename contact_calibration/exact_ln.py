@@ -17,6 +17,13 @@ and −2.1 % at 70 µm (23 rows), N = 144, impedance 1e-3. Loop-closure equality
 solved together with the contact rows (`impose_exact_ln`), so they react to the LN force
 as to any contact force; other inequality constraints (joint limits, friction) are not.
 
+The force is computed from the state at the start of each step, so its damping term is
+explicit. A contact recorded at a low approach speed (a grazing onset, or a journal in
+contact at t = 0, both at the floor) has a damping χ K δ^1.5 / δ̇⁻ that can exceed the
+step's limit (damping · h / effective mass < 2); the force then chatters from step to step.
+Measured on the default slider-crank started 10 µm into its bearing under its 2.7 kN load:
+chatter at h = 1 µs, smooth and within 0.4 % of the reference solver at 0.5 µs.
+
 Pair margins are raised to the polygon's largest gap so that a row exists whenever the
 exact circles touch. Frictionless pairs only (condim 1). The step loop runs in Python, so
 this mode is much slower than `mujoco.rollout` (see benchmarks/calibration_accuracy.md).
@@ -31,7 +38,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-from clearance.contact_calibration.laws import bearing_stiffness, hysteresis_factor
+from clearance.contact_calibration.laws import MIN_APPROACH_SPEED, bearing_stiffness, hysteresis_factor
 from clearance.contact_calibration.scene_impact import SceneImpact, _crossing, _peak, onset_radius
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.probe import ring_scene
@@ -39,8 +46,6 @@ from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters, ModelOptions
 
 __all__ = ["ExactLNContact", "impose_exact_ln", "step_exact_ln", "ExactLNRun", "ExactLNStepError", "exact_ln_impact", "polygon_margin", "ExactLNCost", "exact_ln_cost"]
-
-_TINY_SPEED = 1e-9  # m/s: floor of the recorded approach speed (grazing onsets)
 
 
 def polygon_margin(ring: RingGeometry) -> float:
@@ -63,6 +68,10 @@ class ExactLNContact:
         bearing_site: name of a site at the bearing centre, or None for a bearing fixed at
             the world origin (the one-bearing scene).
 
+    Attributes:
+        min_approach_speed: floor [m/s] on the recorded approach speed
+            (`MIN_APPROACH_SPEED`, the reference solver's default).
+
     Raises:
         ValueError: the law is IMPACT, or a pair has friction (condim > 1).
     """
@@ -83,6 +92,7 @@ class ExactLNContact:
         self.c = clearance.radial_clearance
         self.k = bearing_stiffness(clearance)
         self.chi = hysteresis_factor(clearance.law, clearance.restitution)
+        self.min_approach_speed = MIN_APPROACH_SPEED
         self.approach: float | None = None
         self.last_force = 0.0
         self.last_penetration = -math.inf
@@ -98,12 +108,16 @@ class ExactLNContact:
         return p, v
 
     def force(self, delta: float, rate: float) -> float:
-        """The law's force [N] at δ [m], δ̇ [m/s], updating the contact onset state."""
+        """The law's force [N] at δ [m], δ̇ [m/s], updating the contact onset state.
+
+        The first call with δ > 0 is the onset, also for a journal that starts in contact:
+        it records δ̇⁻ = max(δ̇, ``min_approach_speed``), as the reference solver does.
+        """
         if delta <= 0:
             self.approach = None
             return 0.0
         if self.approach is None:
-            self.approach = max(rate, _TINY_SPEED)
+            self.approach = max(rate, self.min_approach_speed)
         return max(self.k * delta**1.5 * (1.0 + self.chi * rate / self.approach), 0.0)
 
     def targets(self, model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarray, np.ndarray]:

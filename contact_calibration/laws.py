@@ -15,13 +15,15 @@ Conventions:
 
 The dissipative laws share the form F = K δⁿ [1 + χ(cₑ) δ̇/δ̇⁻]; `hysteresis_factor`
 returns χ. Hu–Guo's factor is recalled, not checked: REFERENCES.md notes that one public
-code uses half of it. Ambrósio's friction thresholds v₀ = 1e-4 m/s and v₁ = 1e-3 m/s are
-recalled values (another code uses 1e-3 and 5e-2 m/s).
+code uses half of it, and its first use warns (`UnverifiedLawWarning`). `MIN_APPROACH_SPEED`
+is the floor on δ̇⁻ shared by every solver that records it. Ambrósio's friction thresholds
+v₀ = 1e-4 m/s and v₁ = 1e-3 m/s are recalled values (another code uses 1e-3 and 5e-2 m/s).
 """
 
 from __future__ import annotations
 
 import math
+import warnings
 from typing import Any
 
 import numpy as np
@@ -43,12 +45,40 @@ __all__ = [
     "normal_force",
     "ambrosio_friction",
     "STIFFNESS_FORMULA",
+    "MIN_APPROACH_SPEED",
+    "UnverifiedLawWarning",
 ]
 
 STIFFNESS_FORMULA = "K = 4/(3(sigma_B + sigma_J)) sqrt(R_B R_J/(R_B - R_J)), sigma = (1 - nu^2)/E"
 """The stiffness convention used by `bearing_stiffness` (record it with every output)."""
 
+MIN_APPROACH_SPEED = 1e-3
+"""Floor [m/s] on the approach speed δ̇⁻ recorded at contact onset.
+
+The dissipative laws divide their damping term by δ̇⁻; a grazing onset, or a contact
+already present at t = 0, would otherwise give a near-infinite damping. Both the exact-LN
+MuJoCo mode and the reference solver record max(δ̇ at onset, this floor)."""
+
 Force = Any  # float for scalar inputs, np.ndarray otherwise
+
+
+class UnverifiedLawWarning(UserWarning):
+    """A contact law whose coefficient is recalled, not checked against its paper, is in use."""
+
+
+_warned_unverified: set[ContactLaw] = set()
+
+
+def _warn_unverified(law: ContactLaw) -> None:
+    """Warn once per process that Hu–Guo's hysteresis factor is unverified."""
+    if law is ContactLaw.HU_GUO and law not in _warned_unverified:
+        _warned_unverified.add(law)
+        warnings.warn(
+            "contact law 'hu_guo': its hysteresis factor 3(1 - c_e)/(2 c_e) is recalled, not "
+            "checked against the paper (REFERENCES.md section 1: one public code uses half this "
+            "factor); check it before relying on the results",
+            UnverifiedLawWarning, stacklevel=3,
+        )
 
 
 def _out(x: np.ndarray) -> Force:
@@ -273,7 +303,8 @@ def hu_guo(
 hu_guo.__doc__ = """Hu–Guo (2015): F = K δⁿ [1 + 3(1 − cₑ)/(2cₑ) · δ̇/δ̇⁻]. UNVERIFIED.
 
     REFERENCES.md section 1 marks this factor [recalled]: one public code uses half of it.
-    Check it against the paper before relying on it.
+    Check it against the paper before relying on it. The first use of the law in a process
+    emits an `UnverifiedLawWarning` saying so.
 """ + _ARGS_DOC.format(rng="(0, 1]")
 
 
@@ -356,6 +387,10 @@ def hysteresis_factor(law: ContactLaw, restitution: float) -> float:
         restitution: cₑ [-]; in [0, 1] for LN and Hunt–Crossley, (0, 1] for the laws that
             divide by cₑ; ignored for Hertz.
 
+    Every user of a law resolves its factor here (the laws below, the impact reference, the
+    exact-LN mode, the reference solver), so this is where an `UnverifiedLawWarning` is
+    emitted, once per process, the first time Hu–Guo is used.
+
     Returns:
         χ [-] >= 0.
 
@@ -369,6 +404,7 @@ def hysteresis_factor(law: ContactLaw, restitution: float) -> float:
         return 0.0
     if law is ContactLaw.IMPACT:
         raise ValueError("the IMPACT law has no hysteresis factor: its damping is set by c_max")
+    _warn_unverified(law)
     allow_zero, factor = _FACTORS[law]
     return factor(_restitution(restitution, allow_zero=allow_zero))
 

@@ -9,6 +9,7 @@ command behind ``clearance calibrate``; it returns a process exit status.
 from __future__ import annotations
 
 import argparse
+import io
 import math
 import os
 from dataclasses import dataclass
@@ -91,14 +92,16 @@ def _markdown(result: CalibrationResult, clearance: Clearance, ring: RingGeometr
 
 def _plot(result: CalibrationResult, clearance: Clearance, ring: RingGeometry,
           options: ModelOptions, speeds: np.ndarray, path: Path, exact: bool) -> None:
-    import matplotlib
-
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
+    # A Figure with its own Agg canvas: no pyplot, so the caller's backend (a notebook's,
+    # say) and its open figures are left alone.
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
 
     err, imps, refs = evaluate(clearance, ring, options, result.parameters, mass=result.mass,
                                speeds=speeds, directions=np.array(result.directions))
-    fig, axes = plt.subplots(1, len(speeds), figsize=(4.2 * len(speeds), 3.6), squeeze=False)
+    fig = Figure(figsize=(4.2 * len(speeds), 3.6))
+    FigureCanvasAgg(fig)
+    axes = fig.subplots(1, len(speeds), squeeze=False)
     for ax, v, row, ref in zip(axes[0], speeds, imps, refs):
         ax.plot(ref.times * 1e6, ref.force, "k-", lw=2, label="LN reference")
         for imp, style in zip(row, ("C0--", "C1:")):
@@ -118,10 +121,9 @@ def _plot(result: CalibrationResult, clearance: Clearance, ring: RingGeometry,
     axes[0][0].set_ylabel("normal contact force [N]")
     axes[0][0].legend(fontsize=7)
     fig.tight_layout()
-    tmp = path.with_suffix(".tmp.png")
-    fig.savefig(tmp, dpi=110)
-    plt.close(fig)
-    os.replace(tmp, path)
+    buf = io.BytesIO()
+    fig.savefig(buf, format="png", dpi=110)
+    atomic_write_bytes(path, buf.getvalue())
 
 
 def calibration_report(
@@ -152,7 +154,6 @@ def calibration_report(
     md = out / f"{stem}.md"
     png = out / f"{stem}.png"
     atomic_write_bytes(md, _markdown(result, clearance, ring, options, title, source).encode())
-    out.mkdir(parents=True, exist_ok=True)
     _plot(result, clearance, ring, options, speeds, png, exact_ln)
     return ReportFiles(md, png)
 

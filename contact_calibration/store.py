@@ -2,15 +2,18 @@
 
 The directory is ``$CLEARANCE_CACHE_DIR`` if set, else ``$XDG_CACHE_HOME/clearance`` or
 ``~/.cache/clearance``; calibrations live in its ``calibration/`` subfolder. A file is
-named by the SHA-256 of its canonical key (geometry, materials, law, restitution,
-friction, effective mass and its range, fit speeds, time step, integrator, impedance,
-segment count and shape, geom types, MuJoCo version, fit version) and stores that key, so
-a hash collision or an edited file is detected.
+named ``calib-<first 24 hex digits of the SHA-256 of its canonical key>.json``; the key
+holds geometry, materials, law, restitution, friction, effective mass and its range
+(rounded to `MASS_DIGITS` significant figures, so a last-bit difference between machines
+or thread counts does not force a refit), fit speeds, time step, integrator, impedance,
+segment count and shape, geom types, MuJoCo version and fit version. The file stores that
+key, so a hash collision or an edited file is detected.
 
 Writes are atomic (a temporary file in the same folder, then `os.replace`), so concurrent
 sweep workers never read half a file: at worst two workers fit the same case and the last
 rename wins with identical content. A file that cannot be read, parsed or validated is
-reported with a `CalibrationCacheWarning` naming it, and rebuilt, never used.
+reported with a `CalibrationCacheWarning` naming it, and rebuilt, never used. A folder
+that cannot be written is reported the same way; the fit is then used without being stored.
 """
 
 from __future__ import annotations
@@ -40,6 +43,7 @@ from clearance.results import atomic_write_bytes
 
 __all__ = [
     "CACHE_ENV",
+    "MASS_DIGITS",
     "CalibrationCacheWarning",
     "cache_dir",
     "calibration_key",
@@ -55,8 +59,13 @@ CACHE_ENV = "CLEARANCE_CACHE_DIR"
 """Environment variable naming the cache directory."""
 
 
+MASS_DIGITS = 9
+"""Significant figures of the effective mass and its range in a calibration key."""
+
+
 class CalibrationCacheWarning(UserWarning):
-    """A calibration file was unreadable or inconsistent and is being rebuilt."""
+    """A calibration file was unreadable or inconsistent (it is rebuilt), or could not be
+    written (the fit is used without being stored)."""
 
 
 def cache_dir() -> Path:
@@ -72,7 +81,12 @@ def calibration_key(
     clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
     mass_range: tuple[float, float], speeds: np.ndarray,
 ) -> dict[str, Any]:
-    """Everything a calibration depends on, as a JSON-ready dict (floats kept exact).
+    """Everything a calibration depends on, as a JSON-ready dict.
+
+    Floats are kept exact except the effective mass and its range, which are computed
+    (cycle median of a MuJoCo quantity) and so may differ in the last bits between
+    machines, BLAS builds or thread counts: they are rounded to `MASS_DIGITS` significant
+    figures, far below any difference that changes a fit.
 
     Args:
         clearance: the joint's clearance (geometry, materials, law, cₑ, friction).
@@ -94,8 +108,8 @@ def calibration_key(
         "law": clearance.law.value,
         "restitution": float(clearance.restitution),
         "friction": float(clearance.friction),
-        "effective_mass": float(mass),
-        "mass_range": [float(x) for x in mass_range],
+        "effective_mass": _round_sig(mass),
+        "mass_range": [_round_sig(x) for x in mass_range],
         "speeds": [float(v) for v in speeds],
         "timestep": float(options.timestep),
         "integrator": options.integrator,
@@ -110,13 +124,20 @@ def calibration_key(
     }
 
 
+def _round_sig(x: float, digits: int = MASS_DIGITS) -> float:
+    return float(f"{float(x):.{digits - 1}e}")
+
+
 def _digest(key: dict[str, Any]) -> str:
     text = json.dumps(key, sort_keys=True, separators=(",", ":"))
     return hashlib.sha256(text.encode()).hexdigest()
 
 
 def calibration_path(key: dict[str, Any], directory: Path | None = None) -> Path:
-    """File of a calibration key: ``<cache_dir>/<sha256[:24]>.json``."""
+    """File of a calibration key: ``<cache_dir>/calib-<sha256[:24]>.json``.
+
+    ``cache_dir()`` is already the ``calibration/`` subfolder of the cache directory.
+    """
     return (directory or cache_dir()) / f"calib-{_digest(key)[:24]}.json"
 
 
@@ -136,7 +157,7 @@ def load_calibration(key: dict[str, Any], directory: Path | None = None) -> Cali
     path = calibration_path(key, directory)
     try:
         raw = path.read_bytes()
-    except FileNotFoundError:
+    except (FileNotFoundError, NotADirectoryError):  # no file there (a missing or non-folder cache)
         return None
     except OSError as exc:
         raw, error = None, exc
@@ -188,7 +209,8 @@ def calibrate(
         use_cache: read and write the cache.
 
     Returns:
-        The calibration and its file (None without cache).
+        The calibration and its file (None without cache, or when the cache folder cannot
+        be written: a `CalibrationCacheWarning` names the folder then).
 
     Raises:
         ValueError: neither speeds nor impact_speed given, or bad arguments.
@@ -210,7 +232,18 @@ def calibrate(
             return hit, calibration_path(key)
     result = fit_contact(clearance, ring, options, mass=mass, speeds=speeds, mass_range=mrange,
                          max_penetration=max_penetration)
-    return result, (save_calibration(key, result) if use_cache else None)
+    if not use_cache:
+        return result, None
+    try:
+        return result, save_calibration(key, result)
+    except OSError as exc:
+        folder = calibration_path(key).parent
+        warnings.warn(
+            f"could not store the calibration in {folder} ({type(exc).__name__}: {exc}); "
+            f"using the fit without caching it. Set ${CACHE_ENV} to a writable folder to "
+            "reuse calibrations between runs", CalibrationCacheWarning, stacklevel=2,
+        )
+        return result, None
 
 
 def calibrate_joint(
@@ -235,7 +268,8 @@ def calibrate_joint(
         use_cache: read and write the cache.
 
     Returns:
-        The calibration and its file (None without cache).
+        The calibration and its file (None without cache or when the cache folder cannot
+        be written, see `calibrate`).
 
     Raises:
         ValueError: a joint without clearance, or bad arguments.
@@ -265,11 +299,12 @@ def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Any, options
         options: model options.
 
     Returns:
-        ContactParameters with source ``"calibrated: <file>"``.
+        ContactParameters with source ``"calibrated: <file>"`` (``"calibrated: not
+        cached"`` when the cache folder could not be written).
 
     Raises:
         CalibrationStabilityError: the fitted contact is unstable at the time step.
     """
     result, path = calibrate_joint(joint, ring, sizing, options)
     p = result.parameters
-    return ContactParameters(p.stiffness, p.damping, f"calibrated: {path}")
+    return ContactParameters(p.stiffness, p.damping, f"calibrated: {path or 'not cached'}")

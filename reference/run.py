@@ -119,9 +119,9 @@ def simulate_system(
             closer to a rtol 1e-12 solution than DOP853 with 25 % fewer calls
             (benchmarks/reference_speed.md).
         stabilisation: `Stabilisation` or its value. PROJECTION (default) held the closure
-            error 20x below Baumgarte's (alpha = beta = 5 1/s) at the same cost
-            (benchmarks/reference_speed.md): Baumgarte's 0.2 s time constant is slow
-            against a 12 ms revolution.
+            error over the last tenth of long runs 7-20x below Baumgarte's (alpha = beta =
+            5 1/s) at about the same cost (benchmarks/reference_speed.md): Baumgarte's 0.2 s
+            time constant is slow against a 12 ms revolution.
         max_penetration: penetration [m] treated as divergence; default 5 % of each
             bearing radius.
         track_work: also integrate the work of each drive (metadata ``drive_work``, (n,
@@ -243,7 +243,10 @@ def run_reference(
         rtol, atol, method, stabilisation, max_penetration, track_work, progress: see
             `simulate_system`.
         baumgarte: (alpha, beta) [1/s] for BAUMGARTE stabilisation.
-        min_approach_speed: floor [m/s] on the approach speed recorded at contact onset.
+        min_approach_speed: floor [m/s] on the approach speed recorded at contact onset
+            (also for a journal already in contact at t = 0); the default is
+            `clearance.contact_calibration.MIN_APPROACH_SPEED`, the floor of the exact-LN
+            MuJoCo mode.
         friction_v0, friction_v1: Ambrosio's friction thresholds [m/s] (recalled values).
         impact_c_max, impact_d_max: C_max [N s/m] and d_max [m] for IMPACT-law joints.
 

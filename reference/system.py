@@ -26,6 +26,7 @@ from typing import Any, NamedTuple
 import numpy as np
 from scipy.linalg.lapack import dposv
 
+from clearance.contact_calibration.laws import MIN_APPROACH_SPEED
 from clearance.kinematics import assemble, velocities
 from clearance.model import DriveKind, Joint, Link, Mechanism, MotionLaw
 from clearance.reference.constraints import ConstraintRows
@@ -34,7 +35,7 @@ from clearance.reference.contact import ContactJoint, contact_joints, evaluate_c
 __all__ = ["ReferenceSystem", "SingularConstraintsError", "Evaluation"]
 
 _DEFAULTS: dict[str, Any] = dict(
-    baumgarte=(5.0, 5.0), min_approach_speed=1e-3, friction_v0=1e-4, friction_v1=1e-3,
+    baumgarte=(5.0, 5.0), min_approach_speed=MIN_APPROACH_SPEED, friction_v0=1e-4, friction_v1=1e-3,
     impact_c_max=None, impact_d_max=None,
 )
 
@@ -83,7 +84,8 @@ class ReferenceSystem:
         baumgarte: (alpha, beta) [1/s] of Baumgarte stabilisation; (0, 0) for none (the
             integrator's coordinate projection).
         min_approach_speed: floor [m/s] on the approach speed recorded at contact onset (a
-            grazing onset would otherwise divide the damping term by almost 0).
+            grazing onset would otherwise divide the damping term by almost 0); default
+            `MIN_APPROACH_SPEED` (1e-3 m/s), the floor of the exact-LN MuJoCo mode.
         friction_v0, friction_v1: Ambrosio's friction thresholds [m/s].
         impact_c_max, impact_d_max: C_max [N s/m] and d_max [m] for joints using the IMPACT
             law (required only for those).

@@ -134,7 +134,8 @@ def test_calibrate_writes_the_calibration_a_calibrated_run_reuses(tmp_path, monk
     assert prepared.contact["rod_slider"].source == f"calibrated: {files[0]}"
     # keyed with the cycle's (min, max) effective mass, as prepare sizes it (not (m, m))
     key = json.loads(files[0].read_text())["key"]
-    assert key["mass_range"] == list(prepared.sizing["rod_slider"].effective_mass_range)
+    # (stored to store.MASS_DIGITS = 9 significant figures: equal within 1e-8 relative)
+    assert key["mass_range"] == pytest.approx(list(prepared.sizing["rod_slider"].effective_mass_range), rel=1e-8)
     assert key["mass_range"][0] < key["mass_range"][1]
     out = tmp_path / "run"
     assert main(["run", "--contact-mode", "calibrated", "--duration-ms", "0.3", "--out", str(out), "--no-progress"]) == 0

@@ -185,8 +185,32 @@ def test_public_arguments_are_documented() -> None:
 
     for name in laws.__all__:
         obj = getattr(laws, name)
-        if not callable(obj):
-            continue
+        if not callable(obj) or (isinstance(obj, type) and issubclass(obj, Warning)):
+            continue  # constants, and warning classes (no arguments of their own)
         doc = inspect.getdoc(obj) or ""
         for arg in inspect.signature(obj).parameters:
             assert f"{arg}:" in doc, f"{name}: argument {arg} is not documented"
+
+
+def test_hu_guo_warns_once_that_its_factor_is_unverified(monkeypatch) -> None:
+    import warnings
+
+    monkeypatch.setattr(laws, "_warned_unverified", set())  # as in a fresh process
+    with pytest.warns(laws.UnverifiedLawWarning, match="REFERENCES.md section 1.*half this factor"):
+        hysteresis_factor(ContactLaw.HU_GUO, 0.8)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        hu_guo(D, 0.5, 2.0, stiffness=K, restitution=0.8)  # once per process, not per call
+        for law in DISSIPATIVE:
+            if law is not ContactLaw.HU_GUO:
+                hysteresis_factor(law, 0.8)  # the checked laws never warn
+
+
+def test_reference_and_exact_ln_share_the_approach_speed_floor() -> None:
+    from clearance.builders import slider_crank
+    from clearance.reference import ReferenceSystem
+
+    # one constant: a grazing onset (or a contact present at t = 0) gets the same damping
+    # in the reference solver and in exact-LN mode
+    assert laws.MIN_APPROACH_SPEED == 1e-3  # exact: the floor the reference solver was validated with
+    assert ReferenceSystem(slider_crank()).min_approach_speed == laws.MIN_APPROACH_SPEED
