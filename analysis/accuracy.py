@@ -9,8 +9,8 @@ with the reference in two ways:
   and impulse;
 * by statistics over a steady-state window (`run_statistics`): per-revolution peak contact
   force, 95th percentile of the in-contact force, fraction of time in contact, impacts per
-  revolution, RMS output deviation from the exact ideal mechanism, and the mean and spread
-  of the journal eccentricity |e|. Each statistic carries its own scatter, estimated by
+  revolution, RMS output deviation from the exact ideal mechanism, and the distribution of
+  the journal eccentricity |e| (mean, spread, 10th/50th/90th percentiles). Each statistic carries its own scatter, estimated by
   batch means: the window is cut into blocks of whole revolutions, the statistic is taken
   per block, and the standard error of the whole-window value is std(blocks)/sqrt(blocks).
   That is the run-to-run scatter a statistic of this length has (runs that differ only in
@@ -21,6 +21,7 @@ Works on any `SimulationResult` (MuJoCo or the reference solver).
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable, Mapping
 from dataclasses import asdict, dataclass
 
@@ -29,6 +30,7 @@ import numpy as np
 from clearance.results import SimulationResult
 
 __all__ = [
+    "ECC_PERCENTILES",
     "FORCE_QUANTILES",
     "STATISTICS",
     "FirstImpact",
@@ -50,6 +52,9 @@ STATISTICS: dict[str, str] = {
     "rms_deviation": "RMS deviation of the output from the exact ideal mechanism [output unit]",
     "ecc_mean": "mean journal eccentricity |e| [m]",
     "ecc_std": "standard deviation of |e| [m]",
+    "ecc_p10": "10th percentile of |e| [m]",
+    "ecc_p50": "median of |e| [m]",
+    "ecc_p90": "90th percentile of |e| [m]",
 }
 """Statistic name -> meaning, per clearance joint (the deviation is of the mechanism)."""
 
@@ -161,6 +166,10 @@ def separation_time(run: SimulationResult, ref: SimulationResult, joint: str, *,
     return float(t[apart[0]]) if len(apart) else float(t[-1]) if len(t) else 0.0
 
 
+ECC_PERCENTILES = (10, 50, 90)
+"""Percentiles of |e| among the statistics (the shape of the eccentricity distribution)."""
+
+
 def _joint_stats(times: np.ndarray, jr, period: float) -> dict[str, float]:
     f, p = jr.force_magnitude, jr.penetration
     contact = p > 0
@@ -177,6 +186,7 @@ def _joint_stats(times: np.ndarray, jr, period: float) -> dict[str, float]:
         "impacts_per_rev": onsets * period / span,
         "ecc_mean": float(e.mean()),
         "ecc_std": float(e.std()),
+        **{f"ecc_p{q}": float(v) for q, v in zip(ECC_PERCENTILES, np.percentile(e, ECC_PERCENTILES))},
     }
 
 
@@ -285,10 +295,11 @@ def statistic_errors(
     """Error of each statistic against the reference, with both scatters, on a stated scale.
 
     Errors are relative to the reference's value, except where that value can be close to
-    zero: ``ecc_mean`` and ``ecc_std`` are measured in units of the joint's clearance c
-    (|e| lives in [0, c + δ]; a journal resting on its bearing has ``ecc_std`` near 0), and
-    ``impacts_per_rev`` relative to max(reference, 1) (a joint in permanent contact has
-    none).
+    zero: the eccentricity statistics (``ecc_*``) are measured in units of the joint's
+    clearance c (|e| lives in [0, c + δ]; a journal resting on its bearing has ``ecc_std``
+    near 0), and ``impacts_per_rev`` relative to max(reference, 1) (a joint in permanent
+    contact has none). Any other statistic whose reference value is exactly 0 (a joint that
+    never touches) has error 0 if the run's is 0 too, else infinity.
 
     Args:
         run: `run_statistics` of the run.
@@ -312,8 +323,12 @@ def statistic_errors(
                 scale = max(abs(r.value), 1.0)
             else:
                 scale = abs(r.value) if r.value else float("nan")
+            if math.isnan(scale):  # reference exactly 0: no relative scale
+                error = 0.0 if m.value == r.value else math.inf
+            else:
+                error = (m.value - r.value) / scale
             out[j][k] = {
-                "error": (m.value - r.value) / scale,
+                "error": error,
                 "ref_scatter": r.scatter / scale,
                 "scatter": float(np.hypot(m.scatter, r.scatter)) / scale,
                 "scale": scale,

@@ -59,7 +59,9 @@ class SettingRow:
             is given).
         first_impact: joint -> quantity -> relative error (``onset``: difference [s]).
         first_impact_error: worst |relative error| of the first-impact quantities.
-        separation: joint -> separation time from the reference [s].
+        separation: joint -> separation time from the reference [s]; negative where the
+            run had not separated by the end of the kept rows (the value is minus that end,
+            a lower bound).
         statistics: joint -> statistic -> {error, ref_scatter, scatter}.
         statistics_error: worst |error| over statistics and joints.
         worst_statistic: ``joint: statistic`` of that worst error.
@@ -114,7 +116,8 @@ def _separation(out: Path, scenario: str, key: str, ref: Mapping[str, Any]) -> d
         ea = a[f"{j}/eccentricity"][: len(t)]
         eb = np.column_stack([np.interp(t, b["times"], b[f"{j}/eccentricity"][:, k]) for k in range(2)])
         apart = np.flatnonzero(np.hypot(*(ea - eb).T) > SEPARATION_FRACTION * c)
-        sep[j] = float(t[apart[0]]) if len(apart) else float(t[-1])
+        # never apart within the kept rows: the separation is at least their end (stored negative)
+        sep[j] = float(t[apart[0]]) if len(apart) else -float(t[-1])
     return sep
 
 
@@ -159,7 +162,9 @@ def compare_scenario(scenario: Scenario, out_dir: str | Path, *, fixed_per_rev: 
         if fixed_per_rev:
             row.speedup_fixed = fixed_per_rev / row.cpu_per_rev
         row.first_impact = {j: first_impact_errors(_first(acc, j), _first(ref, j)) for j in ref["first_impact"]}
-        row.first_impact_error = max(abs(e[k]) for e in row.first_impact.values() for k in _FIRST)
+        # a first impact missing on either side (NaN) is the worst error, not one max() may skip
+        row.first_impact_error = max(math.inf if math.isnan(e[k]) else abs(e[k])
+                                     for e in row.first_impact.values() for k in _FIRST)
         row.separation = _separation(out, scenario.name, st.key, ref)
         row.statistics = statistic_errors(_stats(acc), ref_stats, clearance=ref["clearance"])
         worst = max(((abs(v["error"]), f"{j}: {k}") for j, d in row.statistics.items() for k, v in d.items()),
@@ -262,7 +267,7 @@ def speed_error_markdown(scenario: Scenario, rows: Sequence[SettingRow], *, refe
                          + f"{r.error_message.splitlines()[0][:160]} |" + " |" * (len(head) - 6 - bool(fixed_per_rev)))
             continue
         fi = "; ".join(", ".join(_pct(e[k]) for k in _FIRST) for e in r.first_impact.values())
-        sep = ", ".join(f"{1e3 * v:.2f}" for v in r.separation.values())
+        sep = ", ".join(f"{1e3 * v:.2f}" if v >= 0 else f"≥ {-1e3 * v:.2f}" for v in r.separation.values())
         cells = []
         for s in stats:
             worst = max(r.statistics.values(), key=lambda d: abs(d.get(s, {}).get("error", 0.0)))

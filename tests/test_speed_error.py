@@ -85,6 +85,10 @@ def test_run_statistics_values_and_batch_scatter() -> None:
     # blocks of 3 revolutions: peaks mean 30, 60, 90, 120 -> std (ddof 1) / sqrt(4)
     assert s["peak_force"].block_values == pytest.approx((30.0, 60.0, 90.0, 120.0), rel=1e-12)
     assert s["peak_force"].scatter == pytest.approx(np.std([30, 60, 90, 120], ddof=1) / 2, rel=1e-12)
+    # |e| is 1.0 in contact (37.5 % of the samples) and 0.5 out of it: percentiles of that mix
+    assert (s["ecc_p10"].value, s["ecc_p50"].value, s["ecc_p90"].value) == (0.5, 0.5, 1.0)
+    # per block of 3 revolutions (2 at 50 %, 1 at 25 % or the reverse) the median is 0.5 or 1.0
+    assert s["ecc_p50"].block_values == (0.5,) * 4 and s["ecc_p50"].scatter == 0.0
     with pytest.raises(ValueError, match="whole revolutions"):
         run_statistics(res, period=period, skip=period, blocks=13)
 
@@ -100,6 +104,10 @@ def test_statistic_errors_scales() -> None:
     assert e["p95_force"]["ref_scatter"] == pytest.approx(0.02, rel=1e-12)
     assert e["ecc_std"]["error"] == pytest.approx(1e-8 / 1e-4, rel=1e-12)  # in units of c
     assert e["impacts_per_rev"]["error"] == pytest.approx(0.5, rel=1e-12)  # per revolution
+    # a joint the reference never brings into contact: no relative scale; equal is 0, else inf
+    zero = {"J": {"p95_force": Statistic(0.0, 0.0, 4)}}
+    assert statistic_errors(zero, zero)["J"]["p95_force"]["error"] == 0.0
+    assert statistic_errors({"J": {"p95_force": Statistic(5.0, 0.0, 4)}}, zero)["J"]["p95_force"]["error"] == np.inf
 
 
 def test_separation_time() -> None:
