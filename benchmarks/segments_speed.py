@@ -19,8 +19,9 @@ from __future__ import annotations
 import argparse
 import dataclasses
 import platform
-from pathlib import Path
 import time
+
+from _tables import write_keeping_reading  # benchmarks/_tables.py (scripts run from benchmarks/)
 
 from clearance import ModelOptions
 from clearance.builders import slider_crank
@@ -84,14 +85,7 @@ def main() -> None:
             f"| {r['pair']}{tag} | {r['N']} | {r['steps_per_s']:,.0f} | {r['ripple'][0]:.1%} | {r['ripple'][1]:.1%} | "
             f"{r['ripple'][2]:.1%} | {r['peak_kN']:.1f} |"
         )
-    text = "\n".join(lines) + "\n"
-    old = Path(args.out).read_text() if Path(args.out).exists() else ""
-    if "\n## Reading" in old:
-        text += old[old.index("\n## Reading"):]
-    from clearance.results import atomic_write_text
-
-    atomic_write_text(args.out, text)
-    print(text)
+    print(write_keeping_reading(args.out, "\n".join(lines) + "\n"))
 
 
 if __name__ == "__main__":
