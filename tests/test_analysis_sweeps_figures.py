@@ -165,6 +165,14 @@ def test_cli_sweep_and_rank(tmp_path, capsys):
                     "--out", str(tmp_path / "r"), *common])
     assert rc == 0 and "rod_slider" in (tmp_path / "r" / "ranking.md").read_text()
     assert "rod_slider" in capsys.readouterr().out
+    # over drive speed: 1000 and 2000 rpm given in rpm, stored in rad/s (SI inside)
+    rc = main_sweep(["--parameter", "speed", "--points", "2", "--start", "1000", "--stop", "2000", "--periods", "3",
+                     "--sampled", "1", "--out", str(tmp_path / "v"), *common[2:]])
+    assert rc == 0 and (tmp_path / "v" / "bifurcation.png").exists()
+    from clearance.analysis.sweep import load_rows
+
+    speeds = sorted(r["point"]["crank_speed"] for r in load_rows(tmp_path / "v"))
+    assert speeds == pytest.approx([1000 * np.pi / 30, 2000 * np.pi / 30], rel=1e-12)  # exact unit conversion
     with pytest.raises(SystemExit):
         main_sweep(["--mechanism", "no_such", "--out", str(tmp_path / "x")])
 
