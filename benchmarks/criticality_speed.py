@@ -59,7 +59,8 @@ def breakdown(rows: list[dict], wall: float, workers: int) -> dict:
 
 def compare(dir_a: str, dir_b: str) -> None:
     """Print the two rankings side by side and the per-cell mean deviations."""
-    ra, rb = (rank_joints(load_rows(d)) for d in (dir_a, dir_b))
+    out = watt_six_bar().outputs[0]  # the rocker angle: scores in rad/m
+    ra, rb = (rank_joints(load_rows(d), output=out.name, output_kind=out.kind) for d in (dir_a, dir_b))
     sb = {s.joint: s for s in rb.scores}
     print("| joint | rank A | rank B | score A [rad/m] | 95 % interval A | score B [rad/m] | 95 % interval B | B/A |")
     print("|---|---:|---:|---:|---|---:|---|---:|")
