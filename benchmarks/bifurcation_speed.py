@@ -1,12 +1,14 @@
 """Wall time of a bifurcation diagram over clearance for the default slider-crank.
 
-    python benchmarks/bifurcation_speed.py --points 200 --timestep-us 5 --out /tmp/bif
+    python benchmarks/bifurcation_speed.py --points 200 --timestep-us 5 [--contact-mode calibrated] --out /tmp/bif
 
-Default slider-crank (clearance at rod_slider, 5000 rpm), radial clearance 0.01-1 mm
+Default slider-crank (clearance at rod_slider, 5000 rpm; contact mode the package default
+unless given), radial clearance 0.01-1 mm
 (linear spacing), 60 drive periods per point, Poincaré section of the journal eccentricity
 x (bearing frame) over the last 40 periods. Runs through `run_bifurcation` with the local
-spawn process pool; prints the wall time, the per-point simulation times and the regime
-counts, and writes the diagram PNG into the sweep folder. Delete --out to measure from
+spawn process pool; prints the wall time, the per-point times with the worker seconds of
+each stage (preparation including any calibration fit, stepping, ideal twin, evaluation)
+and the regime counts, and writes the diagram PNG into the sweep folder. Delete --out to measure from
 scratch (a rerun resumes and skips finished points).
 """
 
@@ -58,6 +60,7 @@ def main() -> None:
     p.add_argument("--points", type=int, default=200)
     p.add_argument("--timestep-us", type=float, default=5.0)
     p.add_argument("--segments", type=int, default=None)
+    p.add_argument("--contact-mode", default=ModelOptions().contact_mode.value, choices=("nominal", "calibrated"))
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--periods", type=int, default=60)
     p.add_argument("--sampled", type=int, default=40)
@@ -69,7 +72,7 @@ def main() -> None:
         compare(*args.compare)
         return
     values = np.linspace(0.01e-3, 1e-3, args.points)[:: args.every]
-    opts = ModelOptions(timestep=args.timestep_us * 1e-6, segments=args.segments)
+    opts = ModelOptions(timestep=args.timestep_us * 1e-6, segments=args.segments, contact_mode=args.contact_mode)
     t0 = time.perf_counter()
     d = run_bifurcation(values, KeywordFactory(slider_crank), out_dir=args.out, quantity="rod_slider.ex",
                         periods=args.periods, sampled=args.sampled, options=opts, max_workers=args.workers)
@@ -78,11 +81,20 @@ def main() -> None:
     rows = [json.loads(f.read_text()) for f in sorted((Path(args.out) / "points").glob("*.json"))]
     per = [r["timing"]["wall_time_s"] for r in rows]
     counts = {r: d.regimes.count(r) for r in dict.fromkeys(d.regimes)}
+
+    def total(key: str) -> float:
+        return round(sum(r["timing"].get(key) or 0.0 for r in rows), 1)
+
+    stepping = total("stepping_s")
     print(json.dumps({
         "machine": f"{platform.machine()}, {args.workers} workers",
         "points": len(d.values), "timestep_us": args.timestep_us, "segments": args.segments or "ripple rule",
+        "contact_mode": args.contact_mode,
         "wall_s": round(wall, 1), "per_point_s_median": round(statistics.median(per), 2),
         "per_point_s_max": round(max(per), 2), "regimes": counts,
+        "worker_s": {"points": total("wall_time_s"), "stepping": stepping,
+                     "preparation": round(total("simulate_s") - stepping, 1), "ideal": total("ideal_s"),
+                     "evaluation": total("evaluate_s")},
         "errors": sorted({e.split(':')[0] for e in d.errors if e}),
     }, indent=1))
 

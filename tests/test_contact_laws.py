@@ -7,6 +7,8 @@ rel 1e-12, i.e. a few ulps of rounding in the handful of operations each law per
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
@@ -214,3 +216,18 @@ def test_reference_and_exact_ln_share_the_approach_speed_floor() -> None:
     # in the reference solver and in exact-LN mode
     assert laws.MIN_APPROACH_SPEED == 1e-3  # exact: the floor the reference solver was validated with
     assert ReferenceSystem(slider_crank()).min_approach_speed == laws.MIN_APPROACH_SPEED
+
+
+def test_exact_ln_onset_speed_is_the_crossing_speed():
+    """At constant acceleration the crossing speed is exact: delta(t) = d0 + v0 t + a t^2 / 2."""
+    from clearance.contact_calibration.exact_ln import crossing_speed
+
+    h, d0, v0, a = 1e-6, -5e-9, 0.005, 22_000.0  # a grazing onset under a 2 kN load on 0.09 kg
+    v1 = v0 + a * h
+    tau = (-v0 + math.sqrt(v0**2 - 2 * a * d0)) / a  # the root of d0 + v0 t + a t^2 / 2 in [0, h]
+    assert 0 < tau < h
+    # exact for this motion: 1e-12 relative is float round-off of the square root
+    assert crossing_speed(d0, v0, v1, h) == pytest.approx(v0 + a * tau, rel=1e-12)
+    assert crossing_speed(d0, v0, v1, h) < 0.7 * v1  # the speed one step later over-states it by > 40 %
+    # free flight (no acceleration): the speed itself
+    assert crossing_speed(-3e-9, 0.1, 0.1, h) == 0.1
