@@ -85,11 +85,20 @@ def test_elastic_contact_conserves_energy_over_revolutions() -> None:
 
 def test_tighter_tolerance_changes_first_impact_peaks_little() -> None:
     mech = slider_crank()  # default scenario: c = 0.5 mm, 5000 rpm, LN c_e = 0.9, mu = 0
-    peaks = []
+    events = []
     for rtol in (1e-9, 1e-10):
         res = run_reference(mech, 1.5e-3, rtol=rtol, output_interval=1e-6)
-        peaks.append(res.joints["rod_slider"].force_magnitude.max())
-    assert abs(peaks[1] - peaks[0]) / peaks[1] < 0.005  # issue goal: under 0.5 %
+        jr = res.joints["rod_slider"]
+        on = jr.penetration > 0
+        starts = np.flatnonzero(on[1:] & ~on[:-1]) + 1
+        ends = np.flatnonzero(~on[1:] & on[:-1]) + 1
+        # each contact event's peak force (events closed within the window)
+        events.append([jr.force_magnitude[a:b].max() for a, b in zip(starts, ends[ends > starts[0]])])
+    n = min(map(len, events))
+    assert n >= 3  # the first impacts of the default scenario (REFERENCES.md section 6)
+    peaks = np.array([e[:n] for e in events])
+    # issue goal: every first-impact peak changes by under 0.5 % (before the runs separate)
+    assert np.all(np.abs(peaks[1] - peaks[0]) / peaks[1] < 0.005), peaks
 
 
 def test_first_impact_time_and_size_match_reference_facts() -> None:
