@@ -88,13 +88,14 @@ def main() -> None:
         "  pressed and pulled-out starts; an unreachable or too deep start is refused up front.",
         "- exact LN with friction (μ = 0.3): `ValueError` naming the joint, before any step.",
         "",
-        "Reading: nominal and calibrated modes under-estimate deep first impacts by 4–8 % because a",
+        "Reading: nominal and calibrated modes under-estimate deep first impacts by 4–9 % because a",
         "ring of convex segments softens as δ/c grows (force ∝ δ^1.5/√(c+δ)); at c = 0.01 mm the",
         "first impact goes about as deep as the clearance (δ ≈ 9 µm, δ/c ≈ 0.9), where the calibrated",
-        "ring, fitted to LN over impacts of up to 0.76 m/s on a point mass, is 13 % soft; with friction the",
+        "ring, fitted to LN over impacts of up to 0.6 m/s on a point mass, is 14 % soft; with friction the",
         "MuJoCo Coulomb cone (which can stick) differs from Ambrósio's law (which cannot) by about",
-        "10 % on the normal peak; a law as dissipative as Flores at c_e = 0.3 is beyond what one",
-        "constant ring damping can follow (−17 to −25 %). Exact-LN mode stays within 1 % except",
+        "11 % on the normal peak; a law as dissipative as Flores at c_e = 0.3 is beyond what the",
+        "nominal ring damping (sized at 4 m/s) can follow (−21 %), the calibrated fit comes within",
+        "6–7 %. Exact-LN mode stays within 1 % except",
         "for Flores at c_e = 0.3 (+3 %), and does not support friction.",
     ]
     text = "\n".join(lines) + "\n"

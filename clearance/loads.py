@@ -11,7 +11,7 @@ import numpy as np
 from clearance.kinematics import ConstraintSystem, solve_kinematics
 from clearance.model import Mechanism
 
-__all__ = ["generalized_inertial_forces", "joint_reactions"]
+__all__ = ["generalized_inertial_forces", "joint_reaction_vectors", "joint_reactions"]
 
 
 def generalized_inertial_forces(mechanism: Mechanism, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> np.ndarray:
@@ -36,11 +36,19 @@ def generalized_inertial_forces(mechanism: Mechanism, q: np.ndarray, qd: np.ndar
     return out
 
 
-def joint_reactions(mechanism: Mechanism, times: np.ndarray) -> dict[str, np.ndarray]:
-    """Reaction force magnitude [N] at every joint of the ideal twin, shape (n,) each.
+def joint_reaction_vectors(mechanism: Mechanism, times: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+    """Reaction forces of the ideal twin at every joint and drive.
 
-    Solves Phi_q^T lambda = M qdd - Q at each time (the drives' rows give the drive
-    torques, returned under the drive names).
+    Solves Phi_q^T lambda = M qdd - Q at each time.
+
+    Args:
+        mechanism: the mechanism (its ideal twin is solved).
+        times: (n,) times [s].
+
+    Returns:
+        (pairs, drives): joint name -> (n, 2) multipliers of the joint's two constraint
+        rows [N], in the world x/y frame for revolute joints (their direction is the line
+        along which the joint is loaded); drive name -> (n,) drive torque or force.
 
     Raises:
         AssemblyError: the mechanism cannot be assembled at some time.
@@ -50,10 +58,20 @@ def joint_reactions(mechanism: Mechanism, times: np.ndarray) -> dict[str, np.nda
     cs = ConstraintSystem(ideal)
     inert = generalized_inertial_forces(ideal, kin.q, kin.qd, kin.qdd)
     lam = np.array([np.linalg.solve(cs.jacobian(qi).T, fi) for qi, fi in zip(kin.q, inert)])
-    out: dict[str, np.ndarray] = {}
-    for k, name in enumerate(cs.pair_names):
-        out[name] = np.hypot(lam[:, 2 * k], lam[:, 2 * k + 1])
+    pairs = {name: lam[:, 2 * k : 2 * k + 2] for k, name in enumerate(cs.pair_names)}
     base = 2 * len(cs.pair_names)
-    for k, (d, _, _) in enumerate(cs.drives):
-        out[d.name] = lam[:, base + k]
-    return out
+    drives = {d.name: lam[:, base + k] for k, (d, _, _) in enumerate(cs.drives)}
+    return pairs, drives
+
+
+def joint_reactions(mechanism: Mechanism, times: np.ndarray) -> dict[str, np.ndarray]:
+    """Reaction force magnitude [N] at every joint of the ideal twin, shape (n,) each.
+
+    The drives' rows give the drive torques, returned under the drive names (see
+    `joint_reaction_vectors`).
+
+    Raises:
+        AssemblyError: the mechanism cannot be assembled at some time.
+    """
+    pairs, drives = joint_reaction_vectors(mechanism, times)
+    return {**{name: np.hypot(v[:, 0], v[:, 1]) for name, v in pairs.items()}, **drives}

@@ -41,8 +41,8 @@ class JointSizing:
         impact_speed: sqrt(2 peak_load c / m_eff), the speed gained crossing the clearance
             under the peak load [m/s].
         effective_mass: mass seen along the contact normal [kg]: median over the ideal
-            cycle of the direction-median (loop closures and velocity drives held), as
-            `clearance.contact_calibration.cycle_effective_mass` measures it.
+            cycle of the mass along the ideal joint's load (loop closures and velocity
+            drives held), as `clearance.contact_calibration.cycle_effective_mass` measures it.
         effective_mass_range: (min, max) of that mass over the cycle [kg], the range a
             calibration is valid for.
         penetration_limit: divergence bound [m]: 4 x the Hertz penetration of an impact at

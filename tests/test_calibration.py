@@ -244,18 +244,26 @@ def test_cycle_effective_mass(default_prepared):
     from clearance.mjcf import effective_masses
 
     p = default_prepared
-    free = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12,
-                                lock_velocity_drives=False)["rod_slider"]
-    locked = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12)["rod_slider"]
-    # Pose 0 is qpos0 and, without the drive lock, the formula is the qpos0 estimate's:
-    # equal to round-off (1e-9 covers the pose mapping's 1e-12 residual).
+    free = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12, lock_velocity_drives=False,
+                                along_load=False)["rod_slider"]
+    locked = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12, along_load=False)["rod_slider"]
+    # Pose 0 is qpos0 and, without the drive lock, the direction median is the qpos0
+    # estimate's: equal to round-off (1e-9 covers the pose mapping's 1e-12 residual).
     qpos0 = effective_masses(p.model, p.built)["rod_slider"]
     assert free.values[0] == pytest.approx(qpos0, rel=1e-9)
-    assert free.minimum <= free.median <= free.maximum
     # Locking the crank removes mobility, so the mass seen can only grow, at every pose
     # (1e-12: round-off).
     assert np.all(locked.values >= free.values * (1 - 1e-12))
     assert locked.valid_range == (locked.minimum, locked.maximum)
+    # Along the load (the default, what prepare sizes with): at pose 0 the crank is at dead
+    # centre, the rod lies along the guide and so does its load; with the crank locked the
+    # rod's end can only move across the guide, so along it the journal carries the slider
+    # alone: 0.14 kg (REFERENCES.md section 3) to round-off
+    load = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12)["rod_slider"]
+    assert load.values[0] == pytest.approx(0.14, rel=1e-9)
+    assert load.minimum <= load.median <= load.maximum
+    assert p.sizing["rod_slider"].effective_mass == pytest.approx(  # the sizing's (36 poses) is this kind
+        cycle_effective_mass(p.model, p.built, p.mechanism)["rod_slider"].median, rel=1e-12)
 
 
 def test_report_files(fitted, joint, ring, options, tmp_path, monkeypatch):
