@@ -113,7 +113,10 @@ def finding_lag(press: Press, out: Path):
     fl = max([cf[c] for c in big], default=0.0)
     flight_text = (f"it leaves the wall for up to {fl:.0%} of the time and bounces on it" if fl >= 0.01 else
                    "it chatters on the wall (no flight longer than the 0.1 ms row spacing)")
-    verdict = HOLDS if lagging == len(lags) and zig >= len(zz) - 1 else PARTLY if lagging or zig else FAILS
+    # partly: either half of the finding (lag, zig-zag) holds at half the clearances or more
+    half = (len(lags) + 1) // 2
+    verdict = (HOLDS if lagging == len(lags) and zig >= len(zz) - 1
+               else PARTLY if lagging >= half or zig >= half else FAILS)
     text = f"""We ran the press with clearance at A alone, crank 2 (and the servo crank 7) at
 {w:g}π rad/s, for {plan.PRESS_PERIODS} periods ({plan.PRESS_PERIODS * T:.2f} s), and compared the slider
 with the ideal twin over the last {plan.PRESS_PERIODS - 1} periods: the lag is the time shift
@@ -127,8 +130,9 @@ the journal is off its bearing wall after the first period (stored rows, every 0
 {_table(["clearance at A [mm]", "lag [ms]", "lag [deg of crank 2]", "offset [µm]", "velocity zig-zag [-]",
          "time in flight at A"], rows)}
 Criterion: the displacement lags (lag > 0) at every clearance and the velocity zig-zags
-(ratio > 1.2) at all clearances but at most one. The slider lags at {lagging} of {len(lags)}
-clearances and zig-zags at {zig} of {len(zz)}.
+(ratio > 1.2) at all clearances but at most one; partly if either holds at half the
+clearances or more. The slider lags at {lagging} of {len(lags)} clearances and zig-zags at
+{zig} of {len(zz)}.
 
 Why: gravity and the slider load press each journal against one side of its bearing for
 most of the cycle, so the clearance shows as an offset of the slider of about one
