@@ -32,11 +32,12 @@ from clearance.options import ContactMode, ContactParameters, GeomType, ModelOpt
 
 # Small case: the default slider-crank joint (c = 0.5 mm, R_B = 10 mm, steel, LN, ce = 0.9)
 # with N = 72 sphere segments at h = 1 us, fitted over one decade of speed with 4 points.
-# MASS is the default joint's effective mass at qpos0 (`clearance.mjcf.effective_masses`,
-# benchmarks/calibration_accuracy.md case A); JointSizing fits at the cycle median instead
-# (0.0933 kg, case B). Any mass of that order serves these tests.
+# MASS is the default joint's direction-median effective mass at qpos0
+# (`clearance.mjcf.effective_masses`); JointSizing fits at the cycle median of the mass along
+# the joint's load instead (0.145 kg, benchmarks/calibration_accuracy.md case A). Any mass of
+# that order serves these tests.
 MASS = 0.0855  # kg
-SPEEDS = np.geomspace(0.3, 3.0, 4)  # m/s: one decade, inside the default 0.11-5.6 m/s range
+SPEEDS = np.geomspace(0.3, 3.0, 4)  # m/s: one decade, inside the default 0.09-4.3 m/s range
 
 
 @pytest.fixture(scope="module")

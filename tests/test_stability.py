@@ -168,8 +168,8 @@ def _radial_rate(jr):
 @pytest.mark.parametrize("mode", ["nominal", "calibrated", "exact_ln"])
 def test_journal_starting_off_centre_in_contact(mode):
     # exact_ln at 0.5 us: at 1 us the LN damping of a contact recorded at the floor approach
-    # speed, chi*K*delta^1.5/MIN_APPROACH_SPEED = 3e5 N s/m on the joint's 0.093 kg, exceeds
-    # the explicit step's limit (c h / m < 2) and the imposed force chatters
+    # speed, chi*K*delta^1.5/MIN_APPROACH_SPEED = 3e5 N s/m on the 0.14 kg the journal meets
+    # along the guide, exceeds the explicit step's limit (c h / m < 2) and the force chatters
     h = 0.5e-6 if mode == "exact_ln" else 1e-6
     mech = slider_crank()
     r = simulate(mech, duration=50e-6, options=ModelOptions(contact_mode=mode, timestep=h),
