@@ -59,7 +59,10 @@ def plot_speed_error(rows: Mapping[str, Sequence[SettingRow]], *, path: str | Pa
             ax.set_title(f"{name}: {title}", fontsize=10)
             ax.grid(True, which="both", alpha=0.25)
     handles = [plt.Line2D([], [], color=c, marker="o", ls="", label=m) for m, c in _COLORS.items()]
-    handles += [plt.Line2D([], [], color="grey", marker=mk, ls="", label=p.replace("-", "/")) for p, mk in _MARKERS.items()]
+    shown = {f"{r.setting['journal_geom']}-{r.setting['segment_geom']}" for rs in rows.values() for r in rs
+             if r.status == "ok"}  # the legend names only the geom pairs that were run
+    handles += [plt.Line2D([], [], color="grey", marker=mk, ls="", label=p.replace("-", "/"))
+                for p, mk in _MARKERS.items() if p in shown]
     handles += [plt.Line2D([], [], color="k", lw=1, label="Pareto front"),
                 plt.Line2D([], [], color="tab:red", ls="--", label="goal"),
                 plt.Line2D([], [], color="grey", ls=":", label=" / ".join(f"{g:g}×" for g in goals))]
