@@ -82,6 +82,7 @@ HAND = {
 
 
 @pytest.mark.parametrize("law", list(DISSIPATIVE))
+@pytest.mark.filterwarnings("ignore::clearance.contact_calibration.laws.UnverifiedLawWarning")  # tested below
 def test_dissipative_laws_by_hand(law: ContactLaw) -> None:
     chi, f_in, f_out = HAND[law]
     fn = DISSIPATIVE[law]
