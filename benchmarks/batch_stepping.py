@@ -35,7 +35,8 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
-from _tables import write_keeping_reading  # benchmarks/_tables.py (scripts run from benchmarks/)
+from _states import keyframe_state  # benchmarks/_states.py (scripts run from benchmarks/)
+from _tables import write_keeping_reading
 
 from clearance.builders import rpm, slider_crank
 from clearance.options import ModelOptions
@@ -46,21 +47,10 @@ def _options(h: float) -> ModelOptions:
     return ModelOptions(timestep=h, segments=144, contact_mode="nominal")
 
 
-def _initial(prepared) -> tuple[np.ndarray, np.ndarray]:
-    """(full-physics initial state, held control) of a prepared model."""
-    model = prepared.model
-    data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, 0)
-    kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    state = np.empty(mujoco.mj_stateSize(model, kind))
-    mujoco.mj_getState(model, data, state, kind)
-    return state, data.ctrl.copy()
-
-
 def _point(clearance: float, h: float, nstep: int) -> float:
     """Prepare and step one point as a sweep worker does; returns its final slider x [m]."""
     prepared = prepare(slider_crank(radial_clearance=clearance), _options(h))
-    state, ctrl = _initial(prepared)
+    state, ctrl = keyframe_state(prepared.model)
     states, _ = rollout.rollout(prepared.model, mujoco.MjData(prepared.model), state[None],
                                 np.tile(ctrl, (1, 1, 1)), nstep=nstep)
     return float(states[0, -1, 1])
@@ -91,7 +81,7 @@ def main(argv: list[str] | None = None) -> int:
     prepared = [prepare(slider_crank(radial_clearance=float(c)), _options(h)) for c in clearances]
     t_prep = time.perf_counter() - t0
     models = [p.model for p in prepared]
-    init = [_initial(p) for p in prepared]
+    init = [keyframe_state(p.model) for p in prepared]
     states0 = np.stack([s for s, _ in init])
     ctrl = np.stack([c for _, c in init])[:, None, :]
 

@@ -28,6 +28,8 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from _states import keyframe_state  # benchmarks/_states.py (scripts run from benchmarks/)
+
 from clearance.builders import slider_crank
 from clearance.contact_calibration import (
     GOALS,
@@ -194,11 +196,8 @@ def _full_cost(nstep: int = 20000) -> str:
     prep = prepare(slider_crank(), ModelOptions(contact_mode=ContactMode.CALIBRATED, timestep=TIMESTEP))
     model = prep.model
     data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, 0)
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    s0 = np.zeros(mujoco.mj_stateSize(model, spec))
-    mujoco.mj_getState(model, data, s0, spec)
-    ctrl = np.tile(data.ctrl, (nstep, 1))[None]
+    s0, ctrl0 = keyframe_state(model)
+    ctrl = np.tile(ctrl0, (nstep, 1))[None]
     t0 = time.perf_counter()
     mujoco.rollout.rollout(model, data, s0[None], ctrl, nstep=nstep)
     roll = nstep / (time.perf_counter() - t0)

@@ -134,24 +134,17 @@ def mechanism_from_args(args: argparse.Namespace):
     entry = CATALOGUE[args.mechanism]
     builder, speed = entry.builder, entry.speed_keyword
     accepted = inspect.signature(builder).parameters
-    kw, flags = {}, {}
-    for flag, key, value in (("--clearance-mm", "radial_clearance", args.clearance_mm),
-                             ("--clearance-at", "clearance_at", args.clearance_at),
-                             ("--rpm", speed, args.rpm), ("--gravity", "gravity", args.gravity or None)):
-        if value is not None:
-            flags[key] = flag
-    if args.clearance_mm is not None:
-        kw["radial_clearance"] = args.clearance_mm * 1e-3
-    if args.clearance_at is not None:
-        kw["clearance_at"] = tuple(args.clearance_at)
-    if args.rpm is not None:
-        kw[speed] = rpm(args.rpm)
-    if args.gravity:
-        kw["gravity"] = 9.81
-    refused = [flags[k] for k in kw if k not in accepted]
+    given = [(flag, key, value) for flag, key, value in (
+        ("--clearance-mm", "radial_clearance", None if args.clearance_mm is None else args.clearance_mm * 1e-3),
+        ("--clearance-at", "clearance_at", None if args.clearance_at is None else tuple(args.clearance_at)),
+        ("--rpm", speed, None if args.rpm is None else rpm(args.rpm)),
+        ("--gravity", "gravity", 9.81 if args.gravity else None),
+    ) if value is not None]
+    refused = [flag for flag, key, _ in given if key not in accepted]
     if refused:
         raise ValueError(f"mechanism '{args.mechanism}' does not take {', '.join(refused)} from the command line; "
                          "use a scenario file (--scenario)")
+    kw = {key: value for _, key, value in given}
     return builder(**kw)
 
 

@@ -215,6 +215,8 @@ def cycle_effective_mass(
     data.qpos[:] = model.qpos0
     out = {j: np.zeros(n_poses) for j in built.rings}
     loads = joint_reaction_vectors(mechanism, times)[0] if along_load else {}
+    sizes = {j: np.hypot(v[:, 0], v[:, 1]) for j, v in loads.items()}
+    light = {j: LIGHT_LOAD * float(np.max(v)) for j, v in sizes.items()}
     for i, q in enumerate(kin.q):
         res = _set_pose(model, data, bids, q.reshape(-1, 3))
         if res > 1e-8:
@@ -223,10 +225,8 @@ def cycle_effective_mass(
         mujoco.mj_forward(model, data)
         g = _constraint_rows(model, data, mechanism, lock_velocity_drives)
         for j in built.rings:
-            load = loads.get(j)
-            size = float(np.hypot(*load[i])) if load is not None else 0.0
-            if load is not None and size > LIGHT_LOAD * float(np.max(np.hypot(load[:, 0], load[:, 1]))):
-                n = load[i] / size
+            if j in loads and sizes[j][i] > light[j]:
+                n = loads[j][i] / sizes[j][i]
                 out[j][i] = 1.0 / max(float(n @ _mobility(model, data, j, g) @ n), 1e-300)
             else:
                 out[j][i] = _bearing_mass(model, data, j, g, n_dir)

@@ -160,8 +160,9 @@ class ExactLNContact:
         r = float(np.hypot(*e))
         u = e / r if r > 0 else np.array([1.0, 0.0])
         delta = r - self.c
-        f_ln = self.force(delta, float(u @ ed))
-        self.last_force, self.last_penetration, self.last_rate = f_ln, delta, float(u @ ed)
+        rate = float(u @ ed)
+        f_ln = self.force(delta, rate)
+        self.last_force, self.last_penetration, self.last_rate = f_ln, delta, rate
         con = data.contact
         geom = con.geom
         mine = ((geom[:, 0] == self.jg) | (geom[:, 1] == self.jg)) & (con.efc_address >= 0)

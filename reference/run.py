@@ -15,7 +15,7 @@ from typing import Any
 import numpy as np
 
 import clearance
-from clearance.contact_calibration.laws import STIFFNESS_FORMULA
+from clearance.contact_calibration.laws import MIN_APPROACH_SPEED, STIFFNESS_FORMULA
 from clearance.model import DriveKind, Mechanism
 from clearance.reference.integrator import METHODS, IntegrationFailure, Trajectory, integrate_system
 from clearance.reference.output import assemble_result
@@ -222,7 +222,7 @@ def run_reference(
     method: str = "LSODA",
     stabilisation: Stabilisation | str = Stabilisation.PROJECTION,
     baumgarte: tuple[float, float] = (5.0, 5.0),
-    min_approach_speed: float = 1e-3,
+    min_approach_speed: float = MIN_APPROACH_SPEED,
     friction_v0: float = 1e-4,
     friction_v1: float = 1e-3,
     impact_c_max: float | None = None,
