@@ -33,14 +33,15 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+from _states import (
+    keyframe_state,  # benchmarks/_states.py (scripts run from benchmarks/)
+)
+from _tables import write_keeping_reading
+from clearance.builders import rpm, slider_crank
 from mujoco import rollout
 
-from _states import keyframe_state  # benchmarks/_states.py (scripts run from benchmarks/)
-from _tables import write_keeping_reading
-
-from clearance.builders import rpm, slider_crank
 from clearance.options import ModelOptions
-from clearance.preparation import prepare
+from clearance.run.preparation import prepare
 
 
 def _options(h: float) -> ModelOptions:

@@ -22,17 +22,17 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-from clearance.analysis.bifurcation import run_bifurcation
-from clearance.analysis.figures import plot_bifurcation
-from clearance.analysis.sweep import KeywordFactory
+from clearance.analysis.figures.analysis_figures import plot_bifurcation
+from clearance.analysis.sweeps.bifurcation import run_bifurcation
+from clearance.analysis.sweeps.sweep import KeywordFactory
 from clearance.builders import slider_crank
+
 from clearance.options import ModelOptions
 
 
 def compare(dir_a: str, dir_b: str) -> None:
     """Print, per clearance present in both sweeps, regimes, peak force and section statistics."""
-    from clearance.analysis.sweep import load_rows
+    from clearance.analysis.sweeps.sweep import load_rows
 
     rows_b = {round(r["point"]["radial_clearance"], 12): r for r in load_rows(dir_b)}
     print("| c [mm] | regime A | regime B | peak force A [kN] | peak force B [kN] | mean ex A [µm] | mean ex B [µm] "

@@ -27,23 +27,19 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
-
-from _states import keyframe_state  # benchmarks/_states.py (scripts run from benchmarks/)
-
-from clearance.builders import slider_crank
-from clearance.contact_calibration import (
-    GOALS,
-    accuracy_rows,
-    accuracy_table,
-    calibrate,
-    clearance_impact,
-    cycle_effective_mass,
-    default_speeds,
-    exact_ln_cost,
-    exact_ln_impact,
+from _states import (
+    keyframe_state,  # benchmarks/_states.py (scripts run from benchmarks/)
 )
+from clearance.builders import slider_crank
+from clearance.contact_calibration import clearance_impact
+from clearance.contact_calibration.effective_mass import cycle_effective_mass
+from clearance.contact_calibration.exact_ln import exact_ln_cost, exact_ln_impact
+from clearance.contact_calibration.fit import GOALS, accuracy_rows, default_speeds
+from clearance.contact_calibration.report import accuracy_table
+from clearance.contact_calibration.store import calibrate
+
 from clearance.options import ModelOptions
-from clearance.preparation import prepare
+from clearance.run.preparation import prepare
 
 EVAL_SPEEDS = np.geomspace(0.1, 5.0, 8)  # m/s: the issue's range for the default scenario
 
@@ -132,7 +128,8 @@ def _case(title: str, mech, *, speeds=None, cycle: bool = False, eval_speeds=EVA
 def _fit_range_check() -> str:
     """The fit range's top speed (an estimate) against the fastest contact onset of a run."""
     from clearance.builders import rpm
-    from clearance.simulation import simulate
+
+    from clearance.run.simulation import simulate
 
     cases = {"default": slider_crank(), "c = 0.01 mm": slider_crank(radial_clearance=1e-5),
              "c = 0.1 mm": slider_crank(radial_clearance=1e-4), "c = 1 mm": slider_crank(radial_clearance=1e-3),
@@ -189,8 +186,8 @@ def _full_cost(nstep: int = 20000) -> str:
     import copy
 
     import mujoco.rollout
+    from clearance.contact_calibration.exact_ln import ExactLNContact, step_exact_ln
 
-    from clearance.contact_calibration import ExactLNContact, step_exact_ln
     from clearance.options import ContactMode
 
     prep = prepare(slider_crank(), ModelOptions(contact_mode=ContactMode.CALIBRATED, timestep=TIMESTEP))

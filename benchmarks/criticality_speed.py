@@ -24,11 +24,16 @@ import time
 from pathlib import Path
 
 import numpy as np
-
-from clearance.analysis.criticality import ClearanceAtJoint, rank_joints, ranking_markdown, run_criticality
-from clearance.analysis.figures import plot_criticality
-from clearance.analysis.sweep import load_rows
+from clearance.analysis.figures.analysis_figures import plot_criticality
+from clearance.analysis.sweeps.criticality import (
+    ClearanceAtJoint,
+    rank_joints,
+    ranking_markdown,
+    run_criticality,
+)
+from clearance.analysis.sweeps.sweep import load_rows
 from clearance.builders import rpm, watt_six_bar
+
 from clearance.options import ContactMode, ModelOptions
 from clearance.results import atomic_write_text
 

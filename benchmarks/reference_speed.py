@@ -22,13 +22,12 @@ from datetime import datetime, timezone
 
 import numpy as np
 import scipy
-
 from clearance.builders import rpm, slider_crank
 from clearance.reference import run_reference
 
 
 def _period(mech) -> float:
-    return 2 * math.pi / abs(mech.drives[0].speed)
+    return mech.drive_period
 
 
 def _run(mech, duration, repeat: int = 1, **kw):

@@ -20,10 +20,14 @@ import time
 from pathlib import Path
 
 import rerun as rr
-
-from clearance.analysis.rerun_log import DEFAULT_MAX_RATE_HZ, LoggedRun, record_runs
+from clearance.analysis.recording.rerun_log import (
+    DEFAULT_MAX_RATE_HZ,
+    LoggedRun,
+    record_runs,
+)
 from clearance.builders import slider_crank
-from clearance.simulation import default_duration, simulate
+
+from clearance.run.simulation import default_duration, simulate
 
 
 def _best_record(runs: list[LoggedRun], folder: Path, max_rate_hz: float | None) -> tuple[float, int]:

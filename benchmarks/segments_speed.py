@@ -21,13 +21,15 @@ import dataclasses
 import platform
 import time
 
-from _tables import write_keeping_reading  # benchmarks/_tables.py (scripts run from benchmarks/)
-
-from clearance import ModelOptions
+from _tables import (
+    write_keeping_reading,  # benchmarks/_tables.py (scripts run from benchmarks/)
+)
 from clearance.builders import slider_crank
 from clearance.mjcf.probe import measured_ripple, ring_scene
-from clearance.preparation import prepare
-from clearance.simulation import simulate_prepared
+
+from clearance import ModelOptions
+from clearance.run.preparation import prepare
+from clearance.run.simulation import simulate_prepared
 
 PAIRS = [("sphere", "sphere"), ("capsule", "capsule"), ("sphere", "box"), ("cylinder", "box")]
 SEGMENTS = [36, 72, 144, 288]

@@ -21,7 +21,7 @@ import shutil
 import sys
 from pathlib import Path
 
-from clearance.bench import main_bench
+from clearance.cli.bench import main_bench
 
 HERE = Path(__file__).resolve().parent
 

@@ -6,14 +6,29 @@ clearable joints, joints of a criticality ranking, transmission angles, provenan
 imports MuJoCo.
 """
 
-from clearance.builders.catalogue import CATALOGUE, CatalogueEntry, build, check_linkage, names
+from clearance.builders.catalogue import (
+    CATALOGUE,
+    CatalogueEntry,
+    build,
+    check_linkage,
+    names,
+)
 from clearance.builders.four_bar import four_bar
 from clearance.builders.multiloop import eight_bar, ten_bar
 from clearance.builders.press import seven_bar_press
 from clearance.builders.scenario import ScenarioError, dump_scenario, load_scenario
 from clearance.builders.slider_crank import SLIDER_CRANK_JOINTS, rpm, slider_crank
-from clearance.builders.stephenson import stephenson_i, stephenson_i_slider, stephenson_ii_1, stephenson_ii_2
-from clearance.builders.watt import watt_six_bar, watt_six_bar_slider_1, watt_six_bar_slider_2
+from clearance.builders.stephenson import (
+    stephenson_i,
+    stephenson_i_slider,
+    stephenson_ii_1,
+    stephenson_ii_2,
+)
+from clearance.builders.watt import (
+    watt_six_bar,
+    watt_six_bar_slider_1,
+    watt_six_bar_slider_2,
+)
 
 __all__ = [
     "slider_crank",

@@ -15,9 +15,10 @@ import math
 from typing import Any
 
 from clearance.builders._toml_reader import Table
-from clearance.builders._units import UNITS, describe_units, quantity_of
+
 from clearance.kinematics import AssemblyError
 from clearance.model import ContactLaw, Material, Mechanism, MotionLaw
+from clearance.units import UNITS, describe_units, quantity_of
 
 __all__ = ["from_builder"]
 

@@ -12,7 +12,7 @@ import re
 from collections.abc import Sequence
 from typing import Any
 
-from clearance.builders._units import UNITS, describe_units
+from clearance.units import UNITS, describe_units
 
 __all__ = ["ScenarioError", "Locator", "Table"]
 

@@ -17,10 +17,14 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
-
 from clearance.builders._linkage import LinkageInfo
 from clearance.builders.four_bar import FOUR_BAR_INFO, four_bar
-from clearance.builders.multiloop import EIGHT_BAR_INFO, TEN_BAR_INFO, eight_bar, ten_bar
+from clearance.builders.multiloop import (
+    EIGHT_BAR_INFO,
+    TEN_BAR_INFO,
+    eight_bar,
+    ten_bar,
+)
 from clearance.builders.press import PRESS_INFO, seven_bar_press
 from clearance.builders.slider_crank import rpm, slider_crank
 from clearance.builders.stephenson import (
@@ -41,6 +45,7 @@ from clearance.builders.watt import (
     watt_six_bar_slider_1,
     watt_six_bar_slider_2,
 )
+
 from clearance.kinematics import TransmissionAngle, solve_kinematics, transmission_angle
 from clearance.model import DriveKind, Mechanism
 

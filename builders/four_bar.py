@@ -26,6 +26,7 @@ from clearance.builders._linkage import (
     positive,
 )
 from clearance.builders.slider_crank import rpm
+
 from clearance.kinematics import TransmissionAngle
 from clearance.model import (
     STEEL,

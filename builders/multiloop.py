@@ -23,7 +23,11 @@ from collections.abc import Sequence
 
 from clearance.builders._linkage import (
     DEFAULT_LINEAR_DENSITY as _LAM,
+)
+from clearance.builders._linkage import (
     DEFAULT_RADIAL_CLEARANCE as _C,
+)
+from clearance.builders._linkage import (
     ClearanceFactory,
     LinkageInfo,
     bar_link,
@@ -35,6 +39,7 @@ from clearance.builders._linkage import (
     slider_link,
 )
 from clearance.builders.slider_crank import rpm
+
 from clearance.kinematics import TransmissionAngle as _T
 from clearance.model import (
     STEEL,

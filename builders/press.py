@@ -34,6 +34,7 @@ from clearance.builders._linkage import (
     positive,
     slider_link,
 )
+
 from clearance.kinematics import TransmissionAngle
 from clearance.model import (
     STEEL,

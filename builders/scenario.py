@@ -15,7 +15,7 @@ point_a, link_b, point_b, axis, optional ``[joints.clearance]`` with radial_clea
 bearing_radius_mm, journal_link, restitution, friction, law and materials), ``[[drives]]``
 (name, joint, kind, speed_rpm, start_angle_deg, torque_n_m, optional ``[drives.motion]``)
 and ``[[outputs]]`` (name, link, kind, point). Units are part of the key names; any
-length, angle or speed unit of `clearance.builders._units.UNITS` may be used. Files are
+length, angle or speed unit of `clearance.units.UNITS` may be used. Files are
 validated before a `Mechanism` is built; errors name the file, line, table and key. A
 loaded mechanism is assembled once at t = 0, so that a loop that cannot close is reported
 here. `dump_scenario` writes the full form in SI units, atomically; reading it back gives
@@ -32,9 +32,9 @@ from pathlib import Path
 from typing import Any
 
 import tomli_w
-
 from clearance.builders._scenario_builder import from_builder
 from clearance.builders._toml_reader import Locator, ScenarioError, Table
+
 from clearance.kinematics import AssemblyError, SingularPositionError, assemble
 from clearance.model import (
     Clearance,

@@ -26,6 +26,7 @@ from clearance.model import (
     Output,
     OutputKind,
 )
+from clearance.units import UNITS
 
 __all__ = ["slider_crank", "SLIDER_CRANK_JOINTS", "rpm"]
 
@@ -37,7 +38,7 @@ _CLEARABLE = ("crank_rod", "rod_slider")
 
 def rpm(value: float) -> float:
     """Convert revolutions per minute to rad/s."""
-    return value * 2.0 * math.pi / 60.0
+    return value * UNITS["angular_speed"]["rpm"]
 
 
 def slider_crank(

@@ -30,7 +30,11 @@ from collections.abc import Sequence
 
 from clearance.builders._linkage import (
     DEFAULT_LINEAR_DENSITY as _LAM,
+)
+from clearance.builders._linkage import (
     DEFAULT_RADIAL_CLEARANCE as _C,
+)
+from clearance.builders._linkage import (
     ClearanceFactory,
     LinkageInfo,
     advance,
@@ -43,6 +47,7 @@ from clearance.builders._linkage import (
     slider_link,
 )
 from clearance.builders.slider_crank import rpm
+
 from clearance.kinematics import TransmissionAngle as _T
 from clearance.model import (
     STEEL,

@@ -33,6 +33,7 @@ from clearance.builders._linkage import (
     slider_link,
 )
 from clearance.builders.slider_crank import rpm
+
 from clearance.kinematics import TransmissionAngle
 from clearance.model import (
     STEEL,

@@ -1,7 +1,7 @@
 """clearance: planar mechanisms with revolute-joint clearance, simulated in MuJoCo.
 
-Importing this package is cheap: MuJoCo-dependent parts (`simulate`, `simulate_many`,
-`SimulationResult`) are imported on first use.
+Importing this package is cheap: MuJoCo-dependent parts (`simulate`, `SimulationError`,
+`SimulationResult`, `ModelOptions`) are imported on first use.
 """
 
 from __future__ import annotations
@@ -23,13 +23,11 @@ from clearance.model import (
     Output,
     OutputKind,
 )
-
-__version__ = "0.1.0"
+from clearance.version import __version__ as __version__
 
 _LAZY = {
-    "simulate": "clearance.simulation",
-    "simulate_many": "clearance.simulation",
-    "SimulationError": "clearance.simulation",
+    "simulate": "clearance.run.simulation",
+    "SimulationError": "clearance.run.simulation",
     "SimulationResult": "clearance.results",
     "ModelOptions": "clearance.options",
     "ContactMode": "clearance.options",

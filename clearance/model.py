@@ -606,6 +606,17 @@ class Mechanism:
         return tuple(lk for lk in self.links if lk.name != self.ground)
 
     @property
+    def drive_period(self) -> float | None:
+        """Period [s] of the slowest prescribed drive (constant speed or motion law).
+
+        The one time scale every run, statistic and figure of a mechanism uses: default
+        durations are counted in it, the start-up window is one of it. None when every drive
+        is a torque (no set period).
+        """
+        periods = [d.period for d in self.drives if d.kind is not DriveKind.TORQUE]
+        return max(periods) if periods else None
+
+    @property
     def clearance_joints(self) -> tuple[Joint, ...]:
         """Joints that carry a clearance, in declaration order."""
         return tuple(j for j in self.joints if j.clearance is not None)

@@ -1,139 +1,47 @@
 """clearance.contact_calibration: contact laws, impact reference, fitting, exact LN, store.
 
-The pure laws (`laws`) and the point-mass impact reference (`impact`) import no MuJoCo and
-are loaded eagerly. Everything that runs MuJoCo (nominal parameters, the fit, the store,
-exact-LN mode, cycle effective mass, reports) is imported on first use, so
-``import clearance.contact_calibration`` stays cheap.
+The package re-exports its pure parts, which import no MuJoCo: the contact laws (`laws`)
+and the point-mass impact reference (`impact`). The parts that run MuJoCo are imported from
+their own modules, so ``import clearance.contact_calibration`` stays cheap:
 
-Main entry points:
-  * `calibrated_parameters(joint, ring, sizing, options)`: the cached calibration used by
-    `ContactMode.CALIBRATED`;
-  * `calibrate(...)` / `fit_contact(...)`: a full `CalibrationResult` with its accuracy per
-    impact speed;
-  * `exact_ln_impact(...)`, `ExactLNContact`: LN imposed on the rows each step;
-  * `cycle_effective_mass(...)`: effective mass at a bearing over the ideal cycle;
-  * `calibration_report(...)`, `main_calibrate(argv)`: Markdown table + plot, CLI.
+  * `store.calibrated_parameters(joint, ring, sizing, options)`: the cached calibration used
+    by `ContactMode.CALIBRATED`; `store.calibrate(...)`, `fit.fit_contact(...)`: a full
+    `CalibrationResult` with its accuracy per impact speed;
+  * `nominal.nominal_parameters(...)`: contact parameters from the formulas alone;
+  * `exact_ln.exact_ln_impact(...)`, `exact_ln.ExactLNContact`: LN imposed on the rows each step;
+  * `effective_mass.cycle_effective_mass(...)`: effective mass at a bearing over the ideal cycle;
+  * `report.calibration_report(...)`: Markdown table + plot.
 """
 
 from __future__ import annotations
 
-import importlib
-from typing import Any
-
+from clearance.contact_calibration.impact import HertzImpact as HertzImpact
+from clearance.contact_calibration.impact import ImpactResult as ImpactResult
+from clearance.contact_calibration.impact import clearance_impact as clearance_impact
+from clearance.contact_calibration.impact import hertz_impact as hertz_impact
+from clearance.contact_calibration.impact import law_impact as law_impact
+from clearance.contact_calibration.impact import simulate_impact as simulate_impact
 from clearance.contact_calibration.impact import (
-    HertzImpact,
-    ImpactResult,
-    clearance_impact,
-    hertz_impact,
-    law_impact,
-    simulate_impact,
-    simulate_oblique_impact,
+    simulate_oblique_impact as simulate_oblique_impact,
 )
+from clearance.contact_calibration.laws import MIN_APPROACH_SPEED as MIN_APPROACH_SPEED
+from clearance.contact_calibration.laws import STIFFNESS_FORMULA as STIFFNESS_FORMULA
 from clearance.contact_calibration.laws import (
-    MIN_APPROACH_SPEED,
-    STIFFNESS_FORMULA,
-    UnverifiedLawWarning,
-    ambrosio_friction,
-    bearing_stiffness,
-    bearing_stiffness_from,
-    flores,
-    gonthier,
-    hertz,
-    hu_guo,
-    hunt_crossley,
-    hysteresis_factor,
-    impact_law,
-    lankarani_nikravesh,
-    normal_force,
+    UnverifiedLawWarning as UnverifiedLawWarning,
 )
-
-_LAZY = {
-    # nominal
-    "NOMINAL_IMPACT_SPEED": "nominal",
-    "nominal_parameters": "nominal",
-    "ring_impact": "nominal",
-    # MuJoCo scene impacts
-    "SceneImpact": "scene_impact",
-    "scene_impacts": "scene_impact",
-    "ring_gap": "scene_impact",
-    "onset_radius": "scene_impact",
-    # fit
-    "GOALS": "fit",
-    "SpeedRow": "fit",
-    "Stability": "fit",
-    "CalibrationResult": "fit",
-    "CalibrationStabilityError": "fit",
-    "default_speeds": "fit",
-    "reference_impacts": "fit",
-    "evaluate": "fit",
-    "accuracy_rows": "fit",
-    "check_stability": "fit",
-    "fit_contact": "fit",
-    # store
-    "CACHE_ENV": "store",
-    "CalibrationCacheWarning": "store",
-    "cache_dir": "store",
-    "calibration_key": "store",
-    "calibration_path": "store",
-    "load_calibration": "store",
-    "save_calibration": "store",
-    "calibrate": "store",
-    "calibrate_joint": "store",
-    "calibrated_parameters": "store",
-    # exact LN
-    "ExactLNContact": "exact_ln",
-    "impose_exact_ln": "exact_ln",
-    "step_exact_ln": "exact_ln",
-    "ExactLNRun": "exact_ln",
-    "ExactLNStepError": "exact_ln",
-    "ExactLNCost": "exact_ln",
-    "exact_ln_impact": "exact_ln",
-    "exact_ln_cost": "exact_ln",
-    "polygon_margin": "exact_ln",
-    # effective mass
-    "EffectiveMass": "effective_mass",
-    "cycle_effective_mass": "effective_mass",
-    "normal_effective_mass": "effective_mass",
-    # report / CLI
-    "calibration_report": "report",
-    "accuracy_table": "report",
-    "main_calibrate": "report",
-    "ReportFiles": "report",
-}
-
-__all__ = [
-    "HertzImpact",
-    "ImpactResult",
-    "clearance_impact",
-    "hertz_impact",
-    "law_impact",
-    "simulate_impact",
-    "simulate_oblique_impact",
-    "MIN_APPROACH_SPEED",
-    "STIFFNESS_FORMULA",
-    "UnverifiedLawWarning",
-    "ambrosio_friction",
-    "bearing_stiffness",
-    "bearing_stiffness_from",
-    "flores",
-    "gonthier",
-    "hertz",
-    "hu_guo",
-    "hunt_crossley",
-    "hysteresis_factor",
-    "impact_law",
-    "lankarani_nikravesh",
-    "normal_force",
-    *_LAZY,
-]
-
-
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        module = importlib.import_module(f"clearance.contact_calibration.{_LAZY[name]}")
-        return getattr(module, name)
-    raise AttributeError(f"module 'clearance.contact_calibration' has no attribute {name!r}")
-
-
-def __dir__() -> list[str]:
-    return sorted(set(globals()) | set(_LAZY))
+from clearance.contact_calibration.laws import ambrosio_friction as ambrosio_friction
+from clearance.contact_calibration.laws import bearing_stiffness as bearing_stiffness
+from clearance.contact_calibration.laws import (
+    bearing_stiffness_from as bearing_stiffness_from,
+)
+from clearance.contact_calibration.laws import flores as flores
+from clearance.contact_calibration.laws import gonthier as gonthier
+from clearance.contact_calibration.laws import hertz as hertz
+from clearance.contact_calibration.laws import hu_guo as hu_guo
+from clearance.contact_calibration.laws import hunt_crossley as hunt_crossley
+from clearance.contact_calibration.laws import hysteresis_factor as hysteresis_factor
+from clearance.contact_calibration.laws import impact_law as impact_law
+from clearance.contact_calibration.laws import (
+    lankarani_nikravesh as lankarani_nikravesh,
+)
+from clearance.contact_calibration.laws import normal_force as normal_force

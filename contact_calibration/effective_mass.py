@@ -31,10 +31,10 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+from clearance.mjcf.spec import BuiltModel
 
 from clearance.kinematics import solve_kinematics
 from clearance.loads import joint_reaction_vectors
-from clearance.mjcf.spec import BuiltModel
 from clearance.model import DriveKind, Mechanism
 
 __all__ = ["EffectiveMass", "LIGHT_LOAD", "cycle_effective_mass", "normal_effective_mass"]
@@ -205,8 +205,7 @@ def cycle_effective_mass(
     Raises:
         RuntimeError: a cycle pose cannot be reproduced in the model's coordinates.
     """
-    periods = [d.period for d in mechanism.drives if d.kind is not DriveKind.TORQUE]
-    period = max(periods) if periods else 1.0
+    period = mechanism.drive_period or 1.0
     times = np.linspace(0.0, period, n_poses, endpoint=False)
     kin = solve_kinematics(mechanism, times)
     names = [lk.name for lk in mechanism.moving_links]

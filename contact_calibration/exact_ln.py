@@ -37,11 +37,20 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-
-from clearance.contact_calibration.laws import MIN_APPROACH_SPEED, bearing_stiffness, hysteresis_factor
-from clearance.contact_calibration.scene_impact import SceneImpact, _crossing, _peak, onset_radius
+from clearance.contact_calibration.laws import (
+    MIN_APPROACH_SPEED,
+    bearing_stiffness,
+    hysteresis_factor,
+)
+from clearance.contact_calibration.scene_impact import (
+    SceneImpact,
+    _crossing,
+    _peak,
+    onset_radius,
+)
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.probe import ring_scene
+
 from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters, ModelOptions
 

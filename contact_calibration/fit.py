@@ -32,14 +32,18 @@ from dataclasses import asdict, dataclass, field
 
 import mujoco
 import numpy as np
-from scipy.optimize import least_squares
-
 from clearance.contact_calibration.impact import ImpactResult, law_impact
 from clearance.contact_calibration.laws import bearing_stiffness
 from clearance.contact_calibration.nominal import nominal_parameters
-from clearance.contact_calibration.scene_impact import DEFAULT_DIRECTIONS, SceneImpact, scene_impacts
+from clearance.contact_calibration.scene_impact import (
+    DEFAULT_DIRECTIONS,
+    SceneImpact,
+    scene_impacts,
+)
 from clearance.mjcf.bearing import RingGeometry, ring_damping_coefficient, ring_force
 from clearance.mjcf.probe import ring_scene
+from scipy.optimize import least_squares
+
 from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters, ModelOptions
 

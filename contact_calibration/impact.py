@@ -47,11 +47,11 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
+from clearance.contact_calibration import laws
 from scipy.integrate import DenseOutput, OdeSolution, solve_ivp
 from scipy.optimize import minimize_scalar
 from scipy.special import beta
 
-from clearance.contact_calibration import laws
 from clearance.model import Clearance, ContactLaw
 
 __all__ = [
@@ -378,23 +378,11 @@ def _simulate(
     )
 
 
-_SOLVER_ARGS = """
-        rtol: relative tolerance of DOP853 on the scaled state.
-        atol: absolute tolerance on the scaled state (δ/δ_s, δ̇/v); default ``rtol``.
-        max_duration: give up (RuntimeError) if there is no separation by then [s];
-            default 1000 t_s (about 300 Hertz contact durations).
-        n_samples: number of uniform output samples over the contact, >= 2."""
-
-
 def simulate_impact(
     force: ForceLaw, *, mass: float, speed: float, rtol: float = 1e-10,
     atol: float | None = None, max_duration: float | None = None, n_samples: int = 2000,
 ) -> ImpactResult:
-    return _simulate(force, mass, speed, None, 0.0, 1e-4, 1e-3, rtol, atol, max_duration,
-                     n_samples)
-
-
-simulate_impact.__doc__ = f"""Normal impact of a point mass on a wall under a contact law.
+    """Normal impact of a point mass on a wall under a contact law.
 
     Integrates m δ̈ = −F(δ, δ̇, v) from δ = 0, δ̇ = v to separation (δ back to 0 with
     δ̇ < 0; see the module docstring for laws that release before δ = 0).
@@ -404,7 +392,12 @@ simulate_impact.__doc__ = f"""Normal impact of a point mass on a wall under a co
             should return 0 for δ <= 0. Called with floats during integration and tried
             with arrays for the output samples (falling back to one call per sample).
         mass: m [kg], > 0.
-        speed: approach speed v [m/s], > 0.{_SOLVER_ARGS}
+        speed: approach speed v [m/s], > 0.
+        rtol: relative tolerance of DOP853 on the scaled state.
+        atol: absolute tolerance on the scaled state (δ/δ_s, δ̇/v); default ``rtol``.
+        max_duration: give up (RuntimeError) if there is no separation by then [s];
+            default 1000 t_s (about 300 Hertz contact durations).
+        n_samples: number of uniform output samples over the contact, >= 2.
 
     Returns:
         The sampled impact with exact peak values and restitution.
@@ -412,7 +405,9 @@ simulate_impact.__doc__ = f"""Normal impact of a point mass on a wall under a co
     Raises:
         ValueError: if an argument is out of range, or the law cannot stop the mass.
         RuntimeError: if the mass has not separated after ``max_duration``.
-"""
+    """
+    return _simulate(force, mass, speed, None, 0.0, 1e-4, 1e-3, rtol, atol, max_duration,
+                     n_samples)
 
 
 def simulate_oblique_impact(
@@ -420,11 +415,7 @@ def simulate_oblique_impact(
     friction: float, v0: float = 1e-4, v1: float = 1e-3, rtol: float = 1e-10,
     atol: float | None = None, max_duration: float | None = None, n_samples: int = 2000,
 ) -> ImpactResult:
-    return _simulate(force, mass, normal_speed, tangential_speed, friction, v0, v1, rtol, atol,
-                     max_duration, n_samples)
-
-
-simulate_oblique_impact.__doc__ = f"""Oblique impact: `simulate_impact` plus sliding along the wall.
+    """Oblique impact: `simulate_impact` plus sliding along the wall.
 
     The tangential velocity v_T obeys m v̇_T = F_T with F_T = Ambrósio friction on the
     normal force (`laws.ambrosio_friction`). The normal motion does not depend on it.
@@ -436,7 +427,12 @@ simulate_oblique_impact.__doc__ = f"""Oblique impact: `simulate_impact` plus sli
         tangential_speed: tangential velocity at onset [m/s], any sign.
         friction: Coulomb coefficient μ [-], >= 0.
         v0: Ambrósio's no-friction speed [m/s] (default 1e-4, a recalled value).
-        v1: Ambrósio's full-friction speed [m/s] (default 1e-3, a recalled value).{_SOLVER_ARGS}
+        v1: Ambrósio's full-friction speed [m/s] (default 1e-3, a recalled value).
+        rtol: relative tolerance of DOP853 on the scaled state.
+        atol: absolute tolerance on the scaled state (δ/δ_s, δ̇/v); default ``rtol``.
+        max_duration: give up (RuntimeError) if there is no separation by then [s];
+            default 1000 t_s (about 300 Hertz contact durations).
+        n_samples: number of uniform output samples over the contact, >= 2.
 
     Returns:
         The sampled impact, with ``tangential_velocity`` and ``tangential_force`` filled.
@@ -444,7 +440,9 @@ simulate_oblique_impact.__doc__ = f"""Oblique impact: `simulate_impact` plus sli
     Raises:
         ValueError: if an argument is out of range.
         RuntimeError: if the mass has not separated after ``max_duration``.
-"""
+    """
+    return _simulate(force, mass, normal_speed, tangential_speed, friction, v0, v1, rtol, atol,
+                     max_duration, n_samples)
 
 
 def law_impact(

@@ -215,14 +215,22 @@ def _law(
     return _out(_dissipative(delta, delta_dot, v, k, chi, n))
 
 
-_ARGS_DOC = """
+def lankarani_nikravesh(
+    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
+    stiffness: float, restitution: float, exponent: float = 1.5,
+) -> Force:
+    """Lankarani–Nikravesh (1990): F = K δⁿ [1 + 3(1 − cₑ²)/4 · δ̇/δ̇⁻].
+
+    REFERENCES.md section 1 [checked]. Derived for cₑ close to 1 (good for cₑ ≳ 0.7); the
+    restitution of the impact it produces is slightly above cₑ (about 0.913 at cₑ = 0.9).
+
     Args:
         delta: penetration δ [m], any shape; F = 0 where δ <= 0.
         delta_dot: penetration rate δ̇ [m/s] (> 0 approaching), broadcast with ``delta``.
         approach_speed: δ̇⁻ [m/s], > 0: the normal approach speed at contact onset, kept for
             the whole impact; scalar or broadcastable array.
         stiffness: K [N/m^n], > 0.
-        restitution: coefficient of restitution cₑ [-], {rng}.
+        restitution: coefficient of restitution cₑ [-], [0, 1].
         exponent: n [-], > 0 (1.5 for metals).
 
     Returns:
@@ -232,80 +240,127 @@ _ARGS_DOC = """
     Raises:
         ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
             restitution is out of range.
-"""
-
-
-def lankarani_nikravesh(
-    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
-    stiffness: float, restitution: float, exponent: float = 1.5,
-) -> Force:
+    """
     return _law(ContactLaw.LANKARANI_NIKRAVESH, delta, delta_dot, approach_speed,
                 stiffness, restitution, exponent)
-
-
-lankarani_nikravesh.__doc__ = """Lankarani–Nikravesh (1990): F = K δⁿ [1 + 3(1 − cₑ²)/4 · δ̇/δ̇⁻].
-
-    REFERENCES.md section 1 [checked]. Derived for cₑ close to 1 (good for cₑ ≳ 0.7); the
-    restitution of the impact it produces is slightly above cₑ (about 0.913 at cₑ = 0.9).
-""" + _ARGS_DOC.format(rng="[0, 1]")
 
 
 def hunt_crossley(
     delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
     stiffness: float, restitution: float, exponent: float = 1.5,
 ) -> Force:
-    return _law(ContactLaw.HUNT_CROSSLEY, delta, delta_dot, approach_speed,
-                stiffness, restitution, exponent)
-
-
-hunt_crossley.__doc__ = """Hunt–Crossley (1975): F = K δⁿ [1 + 3(1 − cₑ)/2 · δ̇/δ̇⁻].
+    """Hunt–Crossley (1975): F = K δⁿ [1 + 3(1 − cₑ)/2 · δ̇/δ̇⁻].
 
     REFERENCES.md section 1 [checked].
-""" + _ARGS_DOC.format(rng="[0, 1]")
+
+    Args:
+        delta: penetration δ [m], any shape; F = 0 where δ <= 0.
+        delta_dot: penetration rate δ̇ [m/s] (> 0 approaching), broadcast with ``delta``.
+        approach_speed: δ̇⁻ [m/s], > 0: the normal approach speed at contact onset, kept for
+            the whole impact; scalar or broadcastable array.
+        stiffness: K [N/m^n], > 0.
+        restitution: coefficient of restitution cₑ [-], [0, 1].
+        exponent: n [-], > 0 (1.5 for metals).
+
+    Returns:
+        Normal force [N] >= 0, broadcast shape of the inputs (float for scalars). The total
+        is clipped at 0 where the damping term would make it negative (no adhesion).
+
+    Raises:
+        ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
+            restitution is out of range.
+    """
+    return _law(ContactLaw.HUNT_CROSSLEY, delta, delta_dot, approach_speed,
+                stiffness, restitution, exponent)
 
 
 def flores(
     delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
     stiffness: float, restitution: float, exponent: float = 1.5,
 ) -> Force:
-    return _law(ContactLaw.FLORES, delta, delta_dot, approach_speed,
-                stiffness, restitution, exponent)
-
-
-flores.__doc__ = """Flores et al. (2011): F = K δⁿ [1 + 8(1 − cₑ)/(5cₑ) · δ̇/δ̇⁻].
+    """Flores et al. (2011): F = K δⁿ [1 + 8(1 − cₑ)/(5cₑ) · δ̇/δ̇⁻].
 
     REFERENCES.md section 1 [checked]; meant for the whole range of cₑ.
-""" + _ARGS_DOC.format(rng="(0, 1]")
+
+    Args:
+        delta: penetration δ [m], any shape; F = 0 where δ <= 0.
+        delta_dot: penetration rate δ̇ [m/s] (> 0 approaching), broadcast with ``delta``.
+        approach_speed: δ̇⁻ [m/s], > 0: the normal approach speed at contact onset, kept for
+            the whole impact; scalar or broadcastable array.
+        stiffness: K [N/m^n], > 0.
+        restitution: coefficient of restitution cₑ [-], (0, 1].
+        exponent: n [-], > 0 (1.5 for metals).
+
+    Returns:
+        Normal force [N] >= 0, broadcast shape of the inputs (float for scalars). The total
+        is clipped at 0 where the damping term would make it negative (no adhesion).
+
+    Raises:
+        ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
+            restitution is out of range.
+    """
+    return _law(ContactLaw.FLORES, delta, delta_dot, approach_speed,
+                stiffness, restitution, exponent)
 
 
 def gonthier(
     delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
     stiffness: float, restitution: float, exponent: float = 1.5,
 ) -> Force:
-    return _law(ContactLaw.GONTHIER, delta, delta_dot, approach_speed,
-                stiffness, restitution, exponent)
-
-
-gonthier.__doc__ = """Gonthier et al. (2004): F = K δⁿ [1 + (1 − cₑ²)/cₑ · δ̇/δ̇⁻].
+    """Gonthier et al. (2004): F = K δⁿ [1 + (1 − cₑ²)/cₑ · δ̇/δ̇⁻].
 
     REFERENCES.md section 1 [checked].
-""" + _ARGS_DOC.format(rng="(0, 1]")
+
+    Args:
+        delta: penetration δ [m], any shape; F = 0 where δ <= 0.
+        delta_dot: penetration rate δ̇ [m/s] (> 0 approaching), broadcast with ``delta``.
+        approach_speed: δ̇⁻ [m/s], > 0: the normal approach speed at contact onset, kept for
+            the whole impact; scalar or broadcastable array.
+        stiffness: K [N/m^n], > 0.
+        restitution: coefficient of restitution cₑ [-], (0, 1].
+        exponent: n [-], > 0 (1.5 for metals).
+
+    Returns:
+        Normal force [N] >= 0, broadcast shape of the inputs (float for scalars). The total
+        is clipped at 0 where the damping term would make it negative (no adhesion).
+
+    Raises:
+        ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
+            restitution is out of range.
+    """
+    return _law(ContactLaw.GONTHIER, delta, delta_dot, approach_speed,
+                stiffness, restitution, exponent)
 
 
 def hu_guo(
     delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
     stiffness: float, restitution: float, exponent: float = 1.5,
 ) -> Force:
-    return _law(ContactLaw.HU_GUO, delta, delta_dot, approach_speed,
-                stiffness, restitution, exponent)
-
-
-hu_guo.__doc__ = """Hu–Guo (2015): F = K δⁿ [1 + 3(1 − cₑ)/(2cₑ) · δ̇/δ̇⁻]. UNVERIFIED.
+    """Hu–Guo (2015): F = K δⁿ [1 + 3(1 − cₑ)/(2cₑ) · δ̇/δ̇⁻]. UNVERIFIED.
 
     REFERENCES.md section 1 marks this factor [recalled]: one public code uses half of it.
     Check it against the paper before relying on it. The first use of the law in a process
     emits an `UnverifiedLawWarning` saying so.
-""" + _ARGS_DOC.format(rng="(0, 1]")
+
+    Args:
+        delta: penetration δ [m], any shape; F = 0 where δ <= 0.
+        delta_dot: penetration rate δ̇ [m/s] (> 0 approaching), broadcast with ``delta``.
+        approach_speed: δ̇⁻ [m/s], > 0: the normal approach speed at contact onset, kept for
+            the whole impact; scalar or broadcastable array.
+        stiffness: K [N/m^n], > 0.
+        restitution: coefficient of restitution cₑ [-], (0, 1].
+        exponent: n [-], > 0 (1.5 for metals).
+
+    Returns:
+        Normal force [N] >= 0, broadcast shape of the inputs (float for scalars). The total
+        is clipped at 0 where the damping term would make it negative (no adhesion).
+
+    Raises:
+        ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
+            restitution is out of range.
+    """
+    return _law(ContactLaw.HU_GUO, delta, delta_dot, approach_speed,
+                stiffness, restitution, exponent)
 
 
 def _step_cubic(delta: np.ndarray, d_max: float) -> np.ndarray:

@@ -26,7 +26,6 @@ from dataclasses import dataclass
 import mujoco
 import mujoco.rollout
 import numpy as np
-
 from clearance.mjcf.bearing import RingGeometry, segment_centres
 
 __all__ = ["SceneImpact", "ring_gap", "onset_radius", "scene_impacts", "DEFAULT_DIRECTIONS"]

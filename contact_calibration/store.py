@@ -28,7 +28,6 @@ from typing import Any
 
 import mujoco
 import numpy as np
-
 from clearance.contact_calibration.fit import (
     FIT_VERSION,
     CalibrationResult,
@@ -37,6 +36,7 @@ from clearance.contact_calibration.fit import (
     fit_contact,
 )
 from clearance.mjcf.bearing import RingGeometry
+
 from clearance.model import Clearance, Joint
 from clearance.options import ContactParameters, ModelOptions
 from clearance.results import atomic_write_bytes
@@ -287,7 +287,7 @@ def calibrate_joint(
 def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Any, options: ModelOptions) -> ContactParameters:
     """Calibrated per-row contact parameters of a clearance joint (cached).
 
-    The entry point of `ContactMode.CALIBRATED` in `clearance.preparation`; it reuses the
+    The entry point of `ContactMode.CALIBRATED` in `clearance.run.preparation`; it reuses the
     file ``clearance calibrate`` writes for the same scenario and numerics
     (`calibrate_joint`).
 

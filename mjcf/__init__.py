@@ -3,7 +3,12 @@
 This package builds and compiles models; it never runs a simulation.
 """
 
-from clearance.mjcf.bearing import RingGeometry, choose_segments, force_ripple, ring_force
+from clearance.mjcf.bearing import (
+    RingGeometry,
+    choose_segments,
+    force_ripple,
+    ring_force,
+)
 from clearance.mjcf.contact import (
     add_initial_keyframe,
     apply_contact,

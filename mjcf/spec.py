@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-
-from clearance.kinematics import assemble, velocities
 from clearance.mjcf.bearing import RingGeometry, segment_centres
 from clearance.mjcf.tree import BodyTree, body_tree
+
+from clearance.kinematics import assemble, velocities
 from clearance.model import DriveKind, Joint, JointType, Mechanism, OutputKind
 from clearance.options import GeomType, ModelOptions
 

@@ -19,7 +19,12 @@ A `ReferenceSystem` keeps scratch buffers: use one per thread (process pools are
 """
 
 from clearance.reference.examples import journal_in_bearing
-from clearance.reference.integrator import METHODS, IntegrationFailure, Trajectory, integrate_system
+from clearance.reference.integrator import (
+    METHODS,
+    IntegrationFailure,
+    Trajectory,
+    integrate_system,
+)
 from clearance.reference.run import (
     ReferenceSolverError,
     Stabilisation,
@@ -27,7 +32,11 @@ from clearance.reference.run import (
     simulate_system,
     to_result,
 )
-from clearance.reference.system import Evaluation, ReferenceSystem, SingularConstraintsError
+from clearance.reference.system import (
+    Evaluation,
+    ReferenceSystem,
+    SingularConstraintsError,
+)
 
 __all__ = [
     "METHODS",

@@ -21,6 +21,7 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 from clearance.contact_calibration.laws import bearing_stiffness, hysteresis_factor
+
 from clearance.model import Clearance, ContactLaw, Joint
 
 __all__ = ["ContactJoint", "contact_joints", "normal_force_scalar", "friction_scalar"]

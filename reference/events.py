@@ -24,10 +24,9 @@ import math
 from collections.abc import Callable
 
 import numpy as np
-from scipy.optimize import brentq, minimize_scalar
-
 from clearance.reference.contact import evaluate_contact
 from clearance.reference.system import ReferenceSystem
+from scipy.optimize import brentq, minimize_scalar
 
 __all__ = ["gap", "gap_many", "hermite_extreme", "find_mode_change"]
 

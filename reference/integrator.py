@@ -22,10 +22,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import integrate
-
 from clearance.reference.events import find_mode_change, gap
 from clearance.reference.system import ReferenceSystem, SingularConstraintsError
+from scipy import integrate
 
 __all__ = ["Trajectory", "IntegrationFailure", "integrate_system", "METHODS"]
 

@@ -18,10 +18,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-
-from clearance.kinematics import output_kinematics
 from clearance.reference.integrator import Trajectory
 from clearance.reference.system import ReferenceSystem
+
+from clearance.kinematics import output_kinematics
 from clearance.results import JointResult, SimulationResult
 
 __all__ = ["assemble_result"]

@@ -13,14 +13,19 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
-
-import clearance
 from clearance.contact_calibration.laws import MIN_APPROACH_SPEED, STIFFNESS_FORMULA
-from clearance.model import DriveKind, Mechanism
-from clearance.reference.integrator import METHODS, IntegrationFailure, Trajectory, integrate_system
+from clearance.reference.integrator import (
+    METHODS,
+    IntegrationFailure,
+    Trajectory,
+    integrate_system,
+)
 from clearance.reference.output import assemble_result
 from clearance.reference.system import ReferenceSystem
+
+from clearance.model import DriveKind, Mechanism
 from clearance.results import SimulationResult
+from clearance.version import __version__
 
 __all__ = ["Stabilisation", "ReferenceSolverError", "run_reference", "simulate_system"]
 
@@ -336,7 +341,7 @@ def _metadata(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any
         "n_restarts": traj.n_restarts,
         "n_projections": traj.n_projections,
         "wall_time_s": traj.wall_time_s,
-        "package_version": clearance.__version__,
+        "package_version": __version__,
         "mujoco_version": None,
         "time_step": None,
         "segments": None,

@@ -24,13 +24,13 @@ from collections.abc import Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
-from scipy.linalg.lapack import dposv
-
 from clearance.contact_calibration.laws import MIN_APPROACH_SPEED
-from clearance.kinematics import assemble, velocities
-from clearance.model import DriveKind, Joint, Link, Mechanism, MotionLaw
 from clearance.reference.constraints import ConstraintRows
 from clearance.reference.contact import ContactJoint, contact_joints, evaluate_contact
+from scipy.linalg.lapack import dposv
+
+from clearance.kinematics import assemble, velocities
+from clearance.model import DriveKind, Joint, Link, Mechanism, MotionLaw
 
 __all__ = ["ReferenceSystem", "SingularConstraintsError", "Evaluation"]
 

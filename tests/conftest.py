@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import pytest
-
 from clearance.builders import slider_crank
 
 
@@ -16,7 +15,7 @@ def default_mechanism():
 @pytest.fixture(scope="session")
 def default_prepared(default_mechanism):
     from clearance.options import ModelOptions
-    from clearance.preparation import prepare
+    from clearance.run.preparation import prepare
 
     return prepare(default_mechanism, ModelOptions())
 

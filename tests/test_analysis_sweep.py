@@ -6,11 +6,16 @@ import functools
 import json
 
 import pytest
-
-from clearance.analysis.sweep import KeywordFactory, SweepEvaluation, load_rows, run_sweep
+from clearance.analysis.sweeps.sweep import (
+    KeywordFactory,
+    SweepEvaluation,
+    load_rows,
+    run_sweep,
+)
 from clearance.builders import four_bar, rpm, slider_crank
+
 from clearance.options import ModelOptions
-from clearance.simulation import default_duration
+from clearance.run.simulation import default_duration
 
 # low speed and a coarse step keep each point under a second (1000 rpm: T = 60 ms)
 OPTIONS = ModelOptions(timestep=5e-6, segments=36)

@@ -6,18 +6,23 @@ from concurrent.futures import Future
 
 import numpy as np
 import pytest
-
-from clearance.analysis.bifurcation import BifurcationDiagram, bifurcation_from_rows, run_bifurcation
-from clearance.analysis.cli_commands import main_rank, main_sweep
-from clearance.analysis.criticality import (
+from clearance.analysis.sweeps.bifurcation import (
+    BifurcationDiagram,
+    bifurcation_from_rows,
+    run_bifurcation,
+)
+from clearance.analysis.sweeps.criticality import (
     ClearanceAtJoint,
     criticality_candidates,
     rank_joints,
     ranking_markdown,
     run_criticality,
 )
-from clearance.analysis.sweep import KeywordFactory
+from clearance.analysis.sweeps.sweep import KeywordFactory
 from clearance.builders import rpm, slider_crank
+
+from clearance.cli.rank import main_rank
+from clearance.cli.sweep import main_sweep
 from clearance.model import OutputKind
 from clearance.options import ModelOptions
 
@@ -45,7 +50,7 @@ def test_bifurcation_sweep_and_figure(tmp_path):
     assert [len(s) for s in d.samples] == [2, 2]
     # the journal stays within its clearance circle plus penetration (< 0.1 mm here)
     assert all(np.all(np.abs(s) < c + 0.1e-3) for s, c in zip(d.samples, values))
-    from clearance.analysis.figures import plot_bifurcation
+    from clearance.analysis.figures.analysis_figures import plot_bifurcation
 
     png = tmp_path / "bif.png"
     plot_bifurcation(d, path=png)
@@ -82,7 +87,7 @@ def test_criticality_candidates_and_sweep(tmp_path):
     assert (r.output, r.output_kind, r.score_unit) == ("slider_x", OutputKind.POSITION_X, "-")
     md = ranking_markdown(r)
     assert "| 1 |" in md and "rod_slider" in md and "[-]" in md and "[µm]" in md
-    from clearance.analysis.figures import plot_criticality
+    from clearance.analysis.figures.analysis_figures import plot_criticality
 
     fig = plot_criticality(r, path=tmp_path / "crit.png")
     assert fig.axes[0].get_ylabel() == "mean deviation of slider_x / radial clearance [-]"
@@ -93,7 +98,7 @@ def test_criticality_candidates_and_sweep(tmp_path):
 
 
 def test_score_unit_follows_the_output_kind():
-    from clearance.analysis.figures import plot_criticality
+    from clearance.analysis.figures.analysis_figures import plot_criticality
 
     rows = [_row(0, "a", 1e-4, [0.5e-4, 0.6e-4]), _row(1, "b", 1e-4, [0.2e-4, 0.3e-4])]
     angle = rank_joints(rows, output="rocker_angle", output_kind=OutputKind.ANGLE)
@@ -133,8 +138,9 @@ def test_rank_joints_scores_and_confidence():
 
 
 def test_report_writes_markdown_and_figures(tmp_path):
+    from clearance.analysis.figures.report import write_report
+
     from clearance import simulate
-    from clearance.analysis.report import write_report
 
     m = slider_crank(crank_speed=rpm(1000.0))
     res, ideal = simulate(m, options=OPTIONS), simulate(m.ideal_twin(), options=OPTIONS)
@@ -169,7 +175,7 @@ def test_cli_sweep_and_rank(tmp_path, capsys):
     rc = main_sweep(["--parameter", "speed", "--points", "2", "--start", "1000", "--stop", "2000", "--periods", "3",
                      "--sampled", "1", "--out", str(tmp_path / "v"), *common[2:]])
     assert rc == 0 and (tmp_path / "v" / "bifurcation.png").exists()
-    from clearance.analysis.sweep import load_rows
+    from clearance.analysis.sweeps.sweep import load_rows
 
     speeds = sorted(r["point"]["crank_speed"] for r in load_rows(tmp_path / "v"))
     assert speeds == pytest.approx([1000 * np.pi / 30, 2000 * np.pi / 30], rel=1e-12)  # exact unit conversion
@@ -211,15 +217,25 @@ def test_cli_sweeps_and_ranks_the_press(tmp_path, monkeypatch, capsys):
     assert "unknown joint" in capsys.readouterr().err
 
 
-@pytest.mark.parametrize("module", ["statistics", "response", "chaos", "sweep", "bifurcation", "criticality",
-                                    "figures", "report", "cli_commands", "comparisons", "run_store",
-                                    "comparison_figures", "ideal_runs"])
+def _analysis_and_cli_modules() -> list[str]:
+    import pkgutil
+
+    import clearance.analysis
+
+    import clearance.cli
+
+    return [m.name for pkg in (clearance.analysis, clearance.cli)
+            for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + ".")
+            if not m.ispkg and not m.name.endswith("__main__")]  # __main__ runs the command on import
+
+
+@pytest.mark.parametrize("module", _analysis_and_cli_modules())
 def test_every_public_argument_is_documented(module):
     import importlib
     import inspect
 
-    mod = importlib.import_module(f"clearance.analysis.{module}")
-    for name in mod.__all__:
+    mod = importlib.import_module(module)
+    for name in getattr(mod, "__all__", ()):
         obj = getattr(mod, name)
         if not inspect.isfunction(obj):
             continue

@@ -9,24 +9,25 @@ import warnings
 import mujoco
 import numpy as np
 import pytest
-
 from clearance.builders import slider_crank
-from clearance.contact_calibration import (
+from clearance.contact_calibration import clearance_impact
+from clearance.contact_calibration.exact_ln import ExactLNContact, exact_ln_impact
+from clearance.contact_calibration.fit import (
     GOALS,
-    CalibrationCacheWarning,
     CalibrationStabilityError,
-    ExactLNContact,
+    check_stability,
+    evaluate,
+)
+from clearance.contact_calibration.store import (
+    CalibrationCacheWarning,
     calibrate,
     calibration_key,
     calibration_path,
-    check_stability,
-    clearance_impact,
-    evaluate,
-    exact_ln_impact,
     load_calibration,
 )
 from clearance.mjcf.probe import ring_scene
 from clearance.mjcf.spec import ring_geometry
+
 from clearance.model import ContactLaw, Material
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
 
@@ -224,7 +225,8 @@ def test_unwritable_cache_warns_and_keeps_the_fit(joint, ring, options, tmp_path
 
 def test_prepare_calibrated_mode_uses_the_cache(default_mechanism, monkeypatch):
     from clearance.contact_calibration import fit
-    from clearance.preparation import prepare
+
+    from clearance.run.preparation import prepare
 
     opts = ModelOptions(contact_mode=ContactMode.CALIBRATED)
     p1 = prepare(default_mechanism, opts)
@@ -241,7 +243,7 @@ def test_prepare_calibrated_mode_uses_the_cache(default_mechanism, monkeypatch):
 
 
 def test_cycle_effective_mass(default_prepared):
-    from clearance.contact_calibration import cycle_effective_mass
+    from clearance.contact_calibration.effective_mass import cycle_effective_mass
     from clearance.mjcf import effective_masses
 
     p = default_prepared
@@ -268,9 +270,8 @@ def test_cycle_effective_mass(default_prepared):
 
 
 def test_report_files(fitted, joint, ring, options, tmp_path, monkeypatch):
-    from clearance.contact_calibration import calibration_report
-
     import matplotlib
+    from clearance.contact_calibration.report import calibration_report
 
     def no_switch(*args, **kwargs):
         raise AssertionError("the report switched matplotlib's backend")
@@ -287,7 +288,7 @@ def test_report_files(fitted, joint, ring, options, tmp_path, monkeypatch):
 
 
 def test_main_calibrate(tmp_path, capsys):
-    from clearance.contact_calibration import main_calibrate
+    from clearance.cli.calibrate import main_calibrate
 
     assert main_calibrate(["--out", str(tmp_path), "--speeds", "0.3", "3", "--n-speeds", "3"]) == 0
     assert (tmp_path / "calibration_rod_slider.md").is_file()
@@ -299,7 +300,7 @@ def test_main_calibrate(tmp_path, capsys):
 def test_exact_ln_in_the_full_mechanism(default_prepared):
     import copy
 
-    from clearance.contact_calibration import ExactLNContact, step_exact_ln
+    from clearance.contact_calibration.exact_ln import ExactLNContact, step_exact_ln
 
     p = default_prepared
     model = copy.copy(p.model)  # ExactLNContact raises the pair margins in place
@@ -323,7 +324,7 @@ def test_exact_ln_in_the_full_mechanism(default_prepared):
 def test_concurrent_writers_leave_a_valid_file(fitted, joint, ring, options):
     from concurrent.futures import ThreadPoolExecutor
 
-    from clearance.contact_calibration import save_calibration
+    from clearance.contact_calibration.store import save_calibration
 
     result, _ = fitted
     key = calibration_key(joint.clearance, ring, options, mass=MASS, mass_range=(MASS, MASS),

@@ -10,9 +10,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-
 from clearance.builders import CATALOGUE, build, names
 from clearance.builders.catalogue import get
+
 from clearance.kinematics import solve_kinematics
 from clearance.model import DriveKind, JointType
 
@@ -117,6 +117,7 @@ def test_start_angle_stays_on_the_branch(name):
 
 def test_press_drives_are_configurable():
     from clearance.builders import seven_bar_press
+
     from clearance.model import MotionLaw
 
     m = seven_bar_press(crank2_speed=2 * math.pi)
@@ -146,8 +147,7 @@ def test_linkage_plot_labels_every_joint_and_link(built):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-
-    from clearance.analysis.linkage_plot import plot_linkage
+    from clearance.analysis.figures.linkage_plot import plot_linkage
 
     m = built["ten_bar"]
     ax = plot_linkage(m, trace=False)

@@ -15,9 +15,9 @@ import math
 
 import numpy as np
 import pytest
+from clearance.builders import CATALOGUE, four_bar, rpm
 
 from clearance import ModelOptions, simulate
-from clearance.builders import CATALOGUE, four_bar, rpm
 from clearance.kinematics import solve_kinematics
 
 SEGMENTS = 8
@@ -36,7 +36,7 @@ def _setup(name: str) -> tuple[dict, ModelOptions]:
 
 @functools.lru_cache(maxsize=None)
 def _contact():
-    from clearance.preparation import prepare
+    from clearance.run.preparation import prepare
 
     p = prepare(four_bar(crank_speed=rpm(1000), clearance_at=("B",)), ModelOptions(timestep=STEP, segments=SEGMENTS))
     return p.contact["B"]

@@ -67,8 +67,9 @@ def test_rpm_sets_the_catalogue_mechanisms_driven_crank(tmp_path, monkeypatch):
     """--rpm goes to the builder's own speed keyword (the press: crank 2, not 'crank_speed')."""
     import math
 
-    from clearance import cli_options
     from clearance.builders import CATALOGUE
+
+    from clearance.cli import options as cli_options
 
     built = []
     real = cli_options.mechanism_from_args
@@ -77,7 +78,7 @@ def test_rpm_sets_the_catalogue_mechanisms_driven_crank(tmp_path, monkeypatch):
         built.append(real(args))
         return built[-1]
 
-    monkeypatch.setattr("clearance.cli._mechanism", keep)
+    monkeypatch.setattr("clearance.cli.mjcf.mechanism_from_args", keep)
     path = tmp_path / "press.xml"
     assert main(["mjcf", "--mechanism", "seven_bar_press", "--rpm", "45", "--segments", "36", "--out", str(path)]) == 0
     assert CATALOGUE["seven_bar_press"].speed_keyword == "crank2_speed"
@@ -112,9 +113,11 @@ def test_calibrate_writes_the_calibration_a_calibrated_run_reuses(tmp_path, monk
     import json
 
     from clearance.builders import slider_crank
-    from clearance.contact_calibration import cache_dir, store
+    from clearance.contact_calibration import store
+    from clearance.contact_calibration.store import cache_dir
+
     from clearance.options import ModelOptions
-    from clearance.preparation import prepare
+    from clearance.run.preparation import prepare
 
     monkeypatch.setenv("CLEARANCE_CACHE_DIR", str(tmp_path / "cache"))  # an empty cache: fits are counted
     fits = []
@@ -167,6 +170,7 @@ def test_torque_driven_scenario_runs_and_refuses_revolutions(tmp_path, capsys):
     import dataclasses
 
     from clearance.builders import dump_scenario, slider_crank
+
     from clearance.model import Drive, DriveKind
 
     mech = slider_crank(gravity=9.81)

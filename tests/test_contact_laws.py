@@ -11,7 +11,6 @@ import math
 
 import numpy as np
 import pytest
-
 from clearance.contact_calibration import laws
 from clearance.contact_calibration.laws import (
     ambrosio_friction,
@@ -27,6 +26,7 @@ from clearance.contact_calibration.laws import (
     lankarani_nikravesh,
     normal_force,
 )
+
 from clearance.model import STEEL, Clearance, ContactLaw, Material
 
 ULPS = 1e-12  # rel. tolerance: rounding of a few floating-point operations

@@ -4,11 +4,16 @@ from __future__ import annotations
 
 import functools
 
-from clearance.analysis import ideal_runs
-from clearance.analysis.sweep import KeywordFactory, SweepEvaluation, evaluate_point
+from clearance.analysis.sweeps import ideal_runs
+from clearance.analysis.sweeps.sweep import (
+    KeywordFactory,
+    SweepEvaluation,
+    evaluate_point,
+)
 from clearance.builders import rpm, slider_crank
+
 from clearance.options import ModelOptions
-from clearance.simulation import default_duration
+from clearance.run.simulation import default_duration
 
 # 1000 rpm, 2 periods at 5 us and 36 segments: a point takes well under a second
 OPTIONS = ModelOptions(timestep=5e-6, segments=36)

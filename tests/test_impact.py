@@ -6,7 +6,6 @@ import math
 
 import numpy as np
 import pytest
-
 from clearance.contact_calibration.impact import (
     ImpactResult,
     clearance_impact,
@@ -16,6 +15,7 @@ from clearance.contact_calibration.impact import (
     simulate_oblique_impact,
 )
 from clearance.contact_calibration.laws import impact_law, lankarani_nikravesh
+
 from clearance.model import Clearance, ContactLaw
 
 LN = ContactLaw.LANKARANI_NIKRAVESH

@@ -8,11 +8,17 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
-
 from clearance.builders import slider_crank
-from clearance.mjcf import RingGeometry, body_tree, choose_segments, force_ripple, ring_force
+from clearance.mjcf import (
+    RingGeometry,
+    body_tree,
+    choose_segments,
+    force_ripple,
+    ring_force,
+)
+
 from clearance.options import ContactParameters, GeomType, ModelOptions
-from clearance.preparation import prepare
+from clearance.run.preparation import prepare
 
 GOLDEN = Path(__file__).parent / "golden" / "slider_crank.xml"
 
@@ -48,7 +54,7 @@ def test_models_compile_and_step_without_warnings(at, pair):
 
 
 def _cli_geom_pairs() -> list[tuple[str, str]]:
-    from clearance.cli_options import JOURNAL_GEOMS, SEGMENT_GEOMS
+    from clearance.cli.options import JOURNAL_GEOMS, SEGMENT_GEOMS
 
     return [(j, s) for j in JOURNAL_GEOMS for s in SEGMENT_GEOMS]
 
@@ -56,7 +62,7 @@ def _cli_geom_pairs() -> list[tuple[str, str]]:
 @pytest.mark.parametrize("pair", _cli_geom_pairs(), ids=lambda p: f"{p[0]}-{p[1]}")
 def test_every_cli_geom_pair_touches_and_steps_without_warnings(pair):
     """Each journal/segment geom pair `clearance run` offers, with its journals started in contact."""
-    from clearance.initial_state import offset_journals
+    from clearance.run.initial_state import offset_journals
 
     mech = slider_crank(clearance_at=("crank_rod", "rod_slider"), crank_speed=200 * 2 * np.pi / 60)
     xml = prepare(mech, ModelOptions(segments=36, journal_geom=pair[0], segment_geom=pair[1], timestep=2e-6)).to_xml()

@@ -11,12 +11,12 @@ import math
 
 import numpy as np
 import pytest
-
 from clearance.builders import rpm, slider_crank
 from clearance.contact_calibration.impact import clearance_impact
-from clearance.model import Clearance, ContactLaw
 from clearance.reference import run_reference, simulate_system
 from clearance.reference.examples import journal_in_bearing
+
+from clearance.model import Clearance, ContactLaw
 
 R, L = 0.05, 0.12  # crank and rod length of the classic slider-crank [m]
 

@@ -8,10 +8,7 @@ import math
 
 import numpy as np
 import pytest
-
-import clearance
 from clearance.builders import slider_crank
-from clearance.model import Clearance, Joint, JointType, Link
 from clearance.reference import (
     METHODS,
     ReferenceSolverError,
@@ -20,6 +17,9 @@ from clearance.reference import (
     run_reference,
     simulate_system,
 )
+
+import clearance
+from clearance.model import Clearance, Joint, JointType, Link
 from clearance.results import SimulationResult
 
 

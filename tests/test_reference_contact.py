@@ -9,13 +9,17 @@ import math
 
 import numpy as np
 import pytest
-
 from clearance.builders import slider_crank
 from clearance.contact_calibration import laws
-from clearance.model import Clearance, ContactLaw
 from clearance.reference import run_reference
-from clearance.reference.contact import evaluate_contact, friction_scalar, normal_force_scalar
+from clearance.reference.contact import (
+    evaluate_contact,
+    friction_scalar,
+    normal_force_scalar,
+)
 from clearance.reference.examples import journal_in_bearing
+
+from clearance.model import Clearance, ContactLaw
 
 ULPS = 1e-12  # rel. tolerance: the same formula evaluated in floats vs NumPy (rounding)
 IMPACT = dict(c_max=2e5, d_max=1e-5)

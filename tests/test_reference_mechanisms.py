@@ -13,8 +13,9 @@ import math
 
 import numpy as np
 import pytest
-
 from clearance.builders import rpm, slider_crank
+from clearance.reference import ReferenceSystem, run_reference
+
 from clearance.kinematics import ConstraintSystem, solve_kinematics
 from clearance.model import (
     Clearance,
@@ -28,7 +29,6 @@ from clearance.model import (
     Output,
     OutputKind,
 )
-from clearance.reference import ReferenceSystem, run_reference
 
 
 def _bar(name: str, p: tuple[float, float], q: tuple[float, float], pa: str, pb: str, mass: float) -> Link:

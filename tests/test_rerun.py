@@ -5,13 +5,13 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
+import clearance.builders
 import numpy as np
 import pytest
 import rerun as rr
+from clearance.analysis.recording import rerun_log
 
 import clearance
-import clearance.builders
-from clearance.analysis import rerun_log
 from clearance.results import JointResult, SimulationResult
 
 # Points2D / LineStrips2D store float32: a float64 value x comes back as float32(x), whose
@@ -225,7 +225,8 @@ def test_cli_run_writes_a_recording(tmp_path):
     import os
     import stat
 
-    from clearance.analysis.chaos import poincare_from_result
+    from clearance.analysis.chaos.poincare import poincare_from_result
+
     from clearance.cli import main
 
     rrd = tmp_path / "run.rrd"

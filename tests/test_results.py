@@ -50,6 +50,7 @@ def test_output_files_get_the_usual_mode_of_a_new_file(tmp_path):
     import stat
 
     from clearance.contact_calibration.store import save_calibration
+
     from clearance.results import atomic_write_text
 
     old = os.umask(0o022)

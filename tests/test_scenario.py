@@ -8,9 +8,16 @@ import re
 from importlib import resources
 
 import pytest
-
-from clearance.builders import CATALOGUE, ScenarioError, dump_scenario, four_bar, load_scenario, slider_crank
+from clearance.builders import (
+    CATALOGUE,
+    ScenarioError,
+    dump_scenario,
+    four_bar,
+    load_scenario,
+    slider_crank,
+)
 from clearance.builders.scenario import dumps_scenario, loads_scenario
+
 from clearance.model import ContactLaw, Material, MotionLaw
 
 

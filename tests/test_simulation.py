@@ -6,10 +6,10 @@ import math
 
 import numpy as np
 import pytest
+from clearance.builders import rpm, slider_crank
 
 from clearance import ModelOptions, simulate
-from clearance.builders import rpm, slider_crank
-from clearance.simulation import SimulationError
+from clearance.run.simulation import SimulationError
 
 
 @pytest.fixture(scope="module")
@@ -49,7 +49,7 @@ def test_ideal_run_has_no_contact_or_closure_error(ideal_run):
 
 @pytest.fixture(scope="module")
 def clearance_run(default_prepared):
-    from clearance.simulation import simulate_prepared
+    from clearance.run.simulation import simulate_prepared
 
     # one revolution at 5000 rpm = 12 ms
     return simulate_prepared(default_prepared, duration=0.012)
@@ -70,8 +70,8 @@ def test_deepest_penetration_is_the_ln_impact_of_the_fastest_approach(clearance_
     The bound above is loose by design (4x, to catch divergence); this is the physical check.
     """
     import mujoco
-
-    from clearance.contact_calibration import clearance_impact, normal_effective_mass
+    from clearance.contact_calibration import clearance_impact
+    from clearance.contact_calibration.effective_mass import normal_effective_mass
     from clearance.mjcf import ring_force
 
     p, name = default_prepared, "rod_slider"
@@ -147,7 +147,7 @@ def test_contact_force_follows_the_stiffness(clearance_run, default_prepared):
 
 
 def test_time_step_halving_first_impact_peak(default_prepared):
-    from clearance.preparation import prepare
+    from clearance.run.preparation import prepare
 
     mech = default_prepared.mechanism
     # fixed, uncalibrated parameters (CLARIFICATIONS): nominal contact, the same at both steps
@@ -163,7 +163,7 @@ def test_time_step_halving_first_impact_peak(default_prepared):
 
 
 def test_time_step_too_large_is_explained():
-    from clearance.preparation import TimeStepError
+    from clearance.run.preparation import TimeStepError
 
     with pytest.raises(TimeStepError, match=r"largest stable"):
         simulate(slider_crank(), duration=1e-3, options=ModelOptions(timestep=1e-4))
@@ -215,9 +215,13 @@ def test_exact_ln_step_failure_carries_the_steps_before_it():
     import copy
 
     import mujoco
+    from clearance.contact_calibration.exact_ln import (
+        ExactLNContact,
+        ExactLNStepError,
+        step_exact_ln,
+    )
 
-    from clearance.contact_calibration import ExactLNContact, ExactLNStepError, step_exact_ln
-    from clearance.preparation import prepare
+    from clearance.run.preparation import prepare
 
     p = prepare(slider_crank(), ModelOptions(segments=36))
     model = copy.copy(p.model)

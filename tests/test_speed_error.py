@@ -8,8 +8,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
-
-from clearance.analysis.accuracy import (
+from clearance.analysis.metrics.accuracy import (
     Statistic,
     first_impact,
     first_impact_errors,
@@ -17,6 +16,7 @@ from clearance.analysis.accuracy import (
     separation_time,
     statistic_errors,
 )
+
 from clearance.results import JointResult, SimulationResult
 
 
@@ -52,7 +52,7 @@ def test_first_impact_of_a_sampled_half_sine() -> None:
 
 
 def test_first_impact_errors_and_missing_impacts() -> None:
-    from clearance.analysis.accuracy import FirstImpact
+    from clearance.analysis.metrics.accuracy import FirstImpact
 
     a = FirstImpact("J", 1.0e-4, 110.0, 2.0e-6, 0.5, 2e-4)
     b = FirstImpact("J", 0.9e-4, 100.0, 2.5e-6, 0.4, 2e-4)
@@ -121,7 +121,11 @@ def test_separation_time() -> None:
 
 
 def test_pareto_front_and_defaults() -> None:
-    from clearance.analysis.speed_error_report import SettingRow, choose_defaults, pareto_front
+    from clearance.bench.speed_error_report import (
+        SettingRow,
+        choose_defaults,
+        pareto_front,
+    )
 
     def row(key, wall, stat, first):
         return SettingRow("s", key, key, {}, "ok", wall_per_rev=wall, cpu_per_rev=wall, statistics_error=stat,
@@ -136,10 +140,11 @@ def test_pareto_front_and_defaults() -> None:
 
 
 def test_bench_pipeline_end_to_end_and_resume(tmp_path, monkeypatch) -> None:
-    from clearance.analysis.speed_error import Scenario, Setting, run_speed_error
-    from clearance.analysis.speed_error_report import compare_scenario
-    from clearance.bench import write_report
     from clearance.builders import slider_crank
+
+    from clearance.bench.scenarios import write_report
+    from clearance.bench.speed_error import Scenario, Setting, run_speed_error
+    from clearance.bench.speed_error_report import compare_scenario
 
     monkeypatch.setenv("CLEARANCE_CACHE_DIR", str(tmp_path / "cache"))
     sc = Scenario("sc", functools.partial(slider_crank, radial_clearance=0.25e-3), 3, 0.25,

@@ -12,13 +12,13 @@ import math
 
 import numpy as np
 import pytest
-
-from clearance import ContactLaw, ModelOptions, simulate
 from clearance.builders import rpm, slider_crank, ten_bar
 from clearance.builders.multiloop import TEN_BAR_INFO
 from clearance.contact_calibration import MIN_APPROACH_SPEED, lankarani_nikravesh
-from clearance.preparation import TimeStepError
 from clearance.reference import ReferenceSystem, run_reference, simulate_system
+
+from clearance import ContactLaw, ModelOptions, simulate
+from clearance.run.preparation import TimeStepError
 
 FIRST_IMPACT = 0.6e-3  # s: covers the first impact of every slider-crank case below
 

@@ -6,11 +6,17 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
-
-from clearance.analysis.comparisons import joint_distances, linear_fit, rank_agreement, trend, velocity_zigzag
-from clearance.analysis.run_store import RunSpec, run_batch
-from clearance.analysis.sweep import KeywordFactory
+from clearance.analysis.metrics.comparisons import (
+    joint_distances,
+    linear_fit,
+    rank_agreement,
+    trend,
+    velocity_zigzag,
+)
+from clearance.analysis.sweeps.run_store import RunSpec, run_batch
+from clearance.analysis.sweeps.sweep import KeywordFactory
 from clearance.builders import rpm, slider_crank, watt_six_bar
+
 from clearance.options import ModelOptions
 from clearance.results import JointResult, SimulationResult
 
@@ -72,7 +78,7 @@ def test_run_store_digest_resume_and_names(tmp_path):
     assert d.status == "ok" and d.steps == 12_000
     kept = store.result("sc_1000rpm")
     assert len(kept) == 1200
-    from clearance.simulation import simulate
+    from clearance.run.simulation import simulate
 
     full = simulate(make(point), duration=0.06, options=opts)
     # the digest comes from every step of the same deterministic run: equal exactly
@@ -90,8 +96,8 @@ def test_run_store_digest_resume_and_names(tmp_path):
 
 
 def test_comparison_figures_write_pngs(tmp_path):
-    from clearance.analysis.chaos import classify_poincare
-    from clearance.analysis.comparison_figures import (
+    from clearance.analysis.chaos.poincare import classify_poincare
+    from clearance.analysis.figures.comparison_figures import (
         OrbitPanel,
         PoincarePanel,
         TrendPanel,

@@ -6,7 +6,7 @@ Usage (from the repository root, in the project's environment)::
 
 Each mechanism is built with its defaults, followed over one drive cycle with the generic
 kinematics solver (`clearance.builders.check_linkage`), drawn at t = 0 with its joint paths
-(`clearance.analysis.linkage_plot.plot_linkage`), and described in catalogue.md with its
+(`clearance.analysis.figures.linkage_plot.plot_linkage`), and described in catalogue.md with its
 topology, dimensions, provenance, clearable joints and transmission-angle range.
 """
 
@@ -24,11 +24,11 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-
-from clearance.analysis.linkage_plot import plot_linkage  # noqa: E402
+from clearance.analysis.figures.linkage_plot import plot_linkage  # noqa: E402
 from clearance.builders import CATALOGUE, check_linkage  # noqa: E402
-from clearance.builders._units import quantity_of  # noqa: E402
-from clearance.model import DriveKind  # noqa: E402
+
+from clearance.model import DriveKind, OutputKind  # noqa: E402
+from clearance.units import quantity_of  # noqa: E402
 
 HERE = Path(__file__).resolve().parent
 _COMMON = {"clearance_at", "radial_clearance", "bearing_radius", "restitution", "friction", "law", "material",
@@ -129,7 +129,7 @@ def main() -> int:
                        f"smallest singularity measure: {c.min_singularity:.3f}")
             for o in m.outputs:
                 lo, hi = c.outputs[o.name]
-                unit = "rad" if o.kind.value == "angle" else "m"
+                unit = "rad" if o.kind is OutputKind.ANGLE else "m"
                 out.append(f"- output {o.name}: {lo:.4f} to {hi:.4f} {unit}; peak |acceleration| "
                            f"{c.peak_output_acceleration[o.name]:.4g} {unit}/s^2")
             out.append("")

@@ -10,12 +10,20 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-
 import plan
-from clearance.analysis.comparison_figures import TrendPanel, plot_ranking_comparison, plot_trends
-from clearance.analysis.comparisons import joint_distances, linear_fit, rank_agreement, trend
-from clearance.analysis.criticality import ranking_markdown
-from clearance.analysis.figures import plot_criticality
+from clearance.analysis.figures.analysis_figures import plot_criticality
+from clearance.analysis.figures.comparison_figures import (
+    TrendPanel,
+    plot_ranking_comparison,
+    plot_trends,
+)
+from clearance.analysis.metrics.comparisons import (
+    joint_distances,
+    linear_fit,
+    rank_agreement,
+    trend,
+)
+from clearance.analysis.sweeps.criticality import ranking_markdown
 from clearance.builders import CATALOGUE
 from press_findings import FAILS, HOLDS, PARTLY, _g, _table
 

@@ -11,12 +11,16 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
-
-from clearance.analysis.bifurcation import BifurcationDiagram, run_bifurcation
-from clearance.analysis.criticality import ClearanceAtJoint, CriticalityRanking, run_criticality
-from clearance.analysis.run_store import RunSpec, RunStore, run_batch
-from clearance.analysis.sweep import KeywordFactory
+from clearance.analysis.sweeps.bifurcation import BifurcationDiagram, run_bifurcation
+from clearance.analysis.sweeps.criticality import (
+    ClearanceAtJoint,
+    CriticalityRanking,
+    run_criticality,
+)
+from clearance.analysis.sweeps.run_store import RunSpec, RunStore, run_batch
+from clearance.analysis.sweeps.sweep import KeywordFactory
 from clearance.builders import CATALOGUE, rpm, seven_bar_press
+
 from clearance.options import ContactMode, ModelOptions
 
 CONTACT = ContactMode.CALIBRATED  # contact fitted to LN impacts per joint (the package default)

@@ -12,10 +12,10 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
-
 import plan
-from clearance.analysis.chaos import run_section
-from clearance.analysis.comparison_figures import (
+from clearance.analysis.chaos.poincare import run_section
+from clearance.analysis.figures.analysis_figures import plot_bifurcation
+from clearance.analysis.figures.comparison_figures import (
     OrbitPanel,
     PoincarePanel,
     TrendPanel,
@@ -24,10 +24,9 @@ from clearance.analysis.comparison_figures import (
     plot_poincare_panels,
     plot_trends,
 )
-from clearance.analysis.comparisons import trend, velocity_zigzag
-from clearance.analysis.figures import plot_bifurcation
-from clearance.analysis.response import compare_response
-from clearance.analysis.statistics import deviation_statistics
+from clearance.analysis.metrics.comparisons import trend, velocity_zigzag
+from clearance.analysis.metrics.response import compare_response
+from clearance.analysis.metrics.statistics import deviation_statistics
 
 HOLDS, PARTLY, FAILS = "holds", "partly holds", "does not hold"
 OUTPUT = "slider_y"
@@ -108,7 +107,6 @@ def finding_lag(press: Press, out: Path):
     zig = sum(v > 1.2 for v in zz)
     cf = {c: press.flight("A", ("A",), c, w) for c in plan.SERIES_CLEARANCES_MM}
     big = [c for c, z in zip(plan.SERIES_CLEARANCES_MM, zz) if z > 1.2]
-    small = [c for c, z in zip(plan.SERIES_CLEARANCES_MM, zz) if z <= 1.2]
     max_lag = max(abs(v) for v in lags)
     fl = max([cf[c] for c in big], default=0.0)
     flight_text = (f"it leaves the wall for up to {fl:.0%} of the time and bounces on it" if fl >= 0.01 else
@@ -355,7 +353,7 @@ def finding_poincare(press: Press, out: Path):
     text = f"""Clearance at A and C, {" and ".join(_g(c) for c in plan.POINCARE_CLEARANCES_MM)} mm, crank 2 at {w:g}π rad/s,
 {plan.POINCARE_PERIODS} periods at {plan.PRESS_LONG_STEP * 1e6:g} µs; the journal centre at A (bearing frame) sampled
 at t = kT after the first {plan.POINCARE_SKIP} periods and classified by
-`clearance.analysis.chaos.classify_poincare` (coinciding points → periodic; otherwise the
+`clearance.analysis.chaos.poincare.classify_poincare` (coinciding points → periodic; otherwise the
 median nearest-neighbour divergence of the section map: above 0.2 per period → chaotic,
 else quasi-periodic).
 

@@ -7,6 +7,7 @@ from pathlib import Path
 import criticality_findings as cf
 import plan
 import press_findings as pf
+
 from clearance.results import atomic_write_text
 
 INTRO = """# Published clearance-joint findings, reproduced in kind
@@ -47,7 +48,7 @@ Numerical choices (all in `docs/study/plan.py`):
 - Press runs: {plan.PRESS_PERIODS} drive periods at h = {plan.PRESS_STEP * 1e6:g} µs (the first period is the
   start-up transient of journals that start centred with ideal velocities); the clearance
   series of finding 2 was repeated at {plan.PRESS_CHECK_STEP * 1e6:g} µs as a check. Peaks and contact statistics
-  come from every step (`clearance.analysis.run_store` keeps a full-rate digest); the stored
+  come from every step (`clearance.analysis.sweeps.run_store` keeps a full-rate digest); the stored
   rows (every {plan.KEEP_INTERVAL * 1e3:g} ms) serve the figures, the lag and the zig-zag.
 - Poincaré runs and bifurcation diagrams: h = {plan.PRESS_LONG_STEP * 1e6:g} µs, a coarse step chosen as
   in benchmarks/bifurcation_speed.md (there 5 µs at 5000 rpm for the slider-crank; the press

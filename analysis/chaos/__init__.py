@@ -1,0 +1,1 @@
+"""Nonlinear-dynamics tools: phase portraits, Poincaré sections, regime classification."""

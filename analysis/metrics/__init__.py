@@ -1,0 +1,1 @@
+"""Numbers of a run against its ideal twin or a reference: statistics, summary, response, accuracy."""

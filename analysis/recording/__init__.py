@@ -1,0 +1,1 @@
+"""Rerun recordings of runs: journal orbits, contact forces, outputs, the moving mechanism."""

@@ -1,0 +1,1 @@
+"""Many runs through one executor: bifurcation diagrams, criticality ranking, batches of named runs."""

@@ -1,0 +1,92 @@
+"""The one executor and progress bar behind every sweep, ranking, batch of runs and benchmark.
+
+`open_executor` hands out a `concurrent.futures.Executor`: the caller's own (left running),
+a Dask cluster's when a scheduler address is given (its client is closed on exit), or a
+local process pool with the ``spawn`` context (shut down on exit, pending work cancelled).
+Sweep callables must be picklable (module-level functions or `functools.partial`), since
+every point runs in another process. `Progress` is a tqdm bar, or nothing when progress is
+off.
+"""
+
+from __future__ import annotations
+
+import multiprocessing
+import os
+from collections.abc import Iterator
+from concurrent.futures import Executor, ProcessPoolExecutor
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+__all__ = ["Pool", "Progress", "open_executor"]
+
+
+@dataclass(frozen=True)
+class Pool:
+    """An executor and how many tasks it runs at once (``slots``)."""
+
+    executor: Executor
+    slots: int
+
+
+@contextmanager
+def open_executor(
+    executor: Executor | None = None, *, scheduler_address: str | None = None, max_workers: int | None = None,
+) -> Iterator[Pool]:
+    """The executor of a sweep, for the duration of a ``with`` block.
+
+    Args:
+        executor: an executor of the caller's; used as is and not shut down here.
+        scheduler_address: Dask scheduler address (``dask[distributed]`` installed); its
+            client's executor is used and the client closed on exit.
+        max_workers: processes of the local pool (default: CPU count).
+
+    Yields:
+        `Pool` with the executor and its number of slots (workers or Dask threads).
+    """
+    if executor is not None:
+        yield Pool(executor, max_workers or getattr(executor, "_max_workers", None) or os.cpu_count() or 1)
+        return
+    if scheduler_address is not None:
+        from dask.distributed import Client
+
+        client = Client(scheduler_address)
+        try:
+            yield Pool(client.get_executor(), max(1, sum(client.nthreads().values())))
+        finally:
+            client.close()
+        return
+    pool = ProcessPoolExecutor(max_workers=max_workers, mp_context=multiprocessing.get_context("spawn"))
+    try:
+        yield Pool(pool, max_workers or os.cpu_count() or 1)
+    finally:
+        pool.shutdown(wait=True, cancel_futures=True)
+
+
+class Progress:
+    """A progress bar (tqdm) of finished tasks; does nothing when disabled or empty.
+
+    Use as a context manager; `step` counts finished tasks and shows a short label.
+    """
+
+    def __init__(self, total: int, *, enabled: bool = True, desc: str = "runs", unit: str = "run",
+                 initial: int = 0) -> None:
+        self._bar: Any = None
+        if enabled and total:
+            from tqdm import tqdm
+
+            self._bar = tqdm(total=total, initial=initial, unit=unit, desc=desc, smoothing=0.1)
+
+    def __enter__(self) -> Progress:
+        return self
+
+    def step(self, n: int = 1, label: str | None = None) -> None:
+        """Count ``n`` finished tasks; ``label`` (the last task's name) is shown beside the bar."""
+        if self._bar is not None:
+            if label is not None:
+                self._bar.set_postfix_str(label[:60])
+            self._bar.update(n)
+
+    def __exit__(self, *exc: object) -> None:
+        if self._bar is not None:
+            self._bar.close()

@@ -1,0 +1,69 @@
+"""The `clearance` command line: the top of the pipeline (may import everything).
+
+    clearance run        simulate a scenario and write arrays, summary, figures, MJCF
+    clearance reference  run a scenario with the exact-geometry reference solver
+    clearance mjcf       write the MuJoCo model of a scenario
+    clearance calibrate  fit contact parameters to LN impacts and write a report
+    clearance sweep      bifurcation diagram over clearance or drive speed (resumable)
+    clearance rank       joint criticality ranking (resumable)
+    clearance bench      speed against error of MuJoCo settings (resumable)
+
+One module per command; `clearance.cli.options` holds the options they share and is the one
+place units (mm, rpm, µs, ms) are converted to SI. Nothing below this package imports it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+from collections.abc import Callable
+
+from clearance.kinematics import AssemblyError
+
+__all__ = ["main", "build_parser"]
+
+_OWN_PARSER = {
+    "calibrate": ("clearance.cli.calibrate", "main_calibrate",
+                  "fit contact parameters to LN impacts; table and force-time plot"),
+    "sweep": ("clearance.cli.sweep", "main_sweep",
+              "bifurcation diagram over clearance or drive speed (resumable sweep)"),
+    "rank": ("clearance.cli.rank", "main_rank", "joint criticality ranking (resumable sweep)"),
+    "bench": ("clearance.cli.bench", "main_bench",
+              "speed against error of MuJoCo settings against the reference solver"),
+}
+"""Commands with a parser of their own: name -> (module, entry point, help)."""
+
+_SUBPARSERS = ("clearance.cli.run", "clearance.cli.reference", "clearance.cli.mjcf")
+"""Modules whose command is parsed here; each has ``add_parser(sub)`` and ``command(args)``."""
+
+
+def build_parser() -> argparse.ArgumentParser:
+    """The argument parser of the `clearance` command."""
+    p = argparse.ArgumentParser(prog="clearance", description=(__doc__ or "").split("\n\n")[0])
+    sub = p.add_subparsers(dest="command", required=True)
+    for name, (_, _, text) in _OWN_PARSER.items():
+        sub.add_parser(name, help=f"{text} (see 'clearance {name} --help')", add_help=False)
+    for module in _SUBPARSERS:
+        importlib.import_module(module).add_parser(sub)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Entry point of the `clearance` console script; returns the process exit status."""
+    argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] in _OWN_PARSER:
+        module, func, _ = _OWN_PARSER[argv[0]]
+        entry: Callable[[list[str]], int] = getattr(importlib.import_module(module), func)
+        return entry(argv[1:])
+    args = build_parser().parse_args(argv)
+    command: Callable[[argparse.Namespace], int] = args.run_command
+    try:
+        return command(args)
+    except (ValueError, AssemblyError) as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,52 @@
+"""``clearance bench``: speed against error of MuJoCo settings, against the reference solver.
+
+    clearance bench                       full benchmark into clearance-bench/ (hours on 2 cores; resumable)
+    clearance bench --quick               a small grid and short runs (minutes)
+    clearance bench --stage report        only rebuild the table and figure from the files
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+from clearance.bench.scenarios import default_scenarios, write_report
+from clearance.bench.speed_error import run_speed_error
+
+__all__ = ["bench_parser", "main_bench"]
+
+
+def bench_parser() -> argparse.ArgumentParser:
+    """Parser of ``clearance bench``."""
+    p = argparse.ArgumentParser(prog="clearance bench", description=__doc__.split("\n\n")[0])
+    p.add_argument("--out", default="clearance-bench", help="output folder (default clearance-bench); rerun to resume")
+    p.add_argument("--quick", action="store_true", help="small grid and short runs (minutes)")
+    p.add_argument("--scenarios", nargs="*", default=None, metavar="NAME", help="scenarios to run (default all)")
+    p.add_argument("--stage", choices=("all", "accuracy", "timing", "report"), default="all",
+                   help="accuracy runs (parallel), timing runs (one at a time), report, or all (default)")
+    p.add_argument("--workers", type=int, default=None, help="processes for the accuracy runs (default: CPU count)")
+    p.add_argument("--no-progress", action="store_true", help="no progress bars")
+    return p
+
+
+def main_bench(argv: Sequence[str] | None = None) -> int:
+    """Entry point of ``clearance bench``."""
+    args = bench_parser().parse_args(argv)
+    scenarios = default_scenarios(args.quick)
+    if args.scenarios:
+        known = {s.name for s in scenarios}
+        unknown = sorted(set(args.scenarios) - known)
+        if unknown:
+            print(f"error: unknown scenario(s) {unknown}; choose from {sorted(known)}", file=sys.stderr)
+            return 2
+        scenarios = [s for s in scenarios if s.name in args.scenarios]
+    if args.workers is not None and args.workers < 1:
+        print(f"error: --workers must be >= 1 (got {args.workers})", file=sys.stderr)
+        return 2
+    stages = {"all": ("accuracy", "timing"), "report": ()}.get(args.stage, (args.stage,))
+    run_speed_error(scenarios, args.out, stages=stages, max_workers=args.workers, progress=not args.no_progress)
+    if args.stage in ("all", "report"):
+        path = write_report(scenarios, args.out, command="clearance bench " + " ".join(argv or sys.argv[2:]))
+        print(f"wrote {path} and {path.with_suffix('.png')}")
+    return 0

@@ -1,0 +1,86 @@
+"""``clearance calibrate``: fit the contact of every clearance joint of a scenario to LN impacts."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+
+import numpy as np
+
+from clearance.cli.options import (
+    add_scenario_args,
+    mechanism_from_args,
+    options_from_args,
+    positive,
+)
+
+__all__ = ["calibrate_parser", "main_calibrate"]
+
+
+def calibrate_parser() -> argparse.ArgumentParser:
+    """Parser of ``clearance calibrate``."""
+    p = argparse.ArgumentParser(
+        prog="clearance calibrate",
+        description="Fit the MuJoCo contact of every clearance joint of a scenario to LN impacts, at the "
+                    "sizing 'clearance run' uses (effective mass: median over the ideal cycle, with its "
+                    "min-max range; fit speeds: impact speed / 50 to impact speed). The calibration file "
+                    "is what 'clearance run --contact-mode calibrated' then reuses for the same scenario "
+                    "and numerics.")
+    add_scenario_args(p, contact_mode=False)
+    g = p.add_argument_group("fit")
+    g.add_argument("--speeds", type=positive(float, "--speeds"), nargs=2, metavar=("LO", "HI"), default=None,
+                   help="fit over LO..HI [m/s] instead of the default range; such a fit is stored on its "
+                        "own and is not the one 'clearance run --contact-mode calibrated' reuses")
+    g.add_argument("--n-speeds", type=positive(int, "--n-speeds"), default=None,
+                   help="number of log-spaced speeds between LO and HI (with --speeds only; default 8)")
+    g.add_argument("--no-cache", action="store_true", help="refit even if a calibration file exists")
+    p.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
+    return p
+
+
+def main_calibrate(argv: Sequence[str] | None = None) -> int:
+    """``clearance calibrate``: calibrate every clearance joint of a scenario.
+
+    Takes the scenario and numerics options of ``clearance run`` and sizes each joint as
+    `clearance.run.preparation.prepare` does, so that the calibration file written is the one
+    a run in ``contact_mode="calibrated"`` reads. Writes ``calibration_<joint>.md`` and
+    ``.png`` in ``--out`` and prints the table.
+
+    Returns:
+        0 on success, 2 on bad input or an unstable calibration.
+    """
+    from clearance.contact_calibration.fit import CalibrationStabilityError
+    from clearance.contact_calibration.report import calibration_report
+    from clearance.contact_calibration.store import calibrate_joint
+    from clearance.run.preparation import prepare
+
+    p = calibrate_parser()
+    args = p.parse_args(argv)
+    if args.speeds is not None and not args.speeds[0] < args.speeds[1]:
+        p.error(f"--speeds: LO must be below HI (got {args.speeds[0]:g} {args.speeds[1]:g} m/s)")
+    if args.n_speeds is not None and args.speeds is None:
+        p.error("--n-speeds needs --speeds LO HI (the default fit uses 8 speeds from impact speed / 50 "
+                "to impact speed, the ones a calibrated run reuses)")
+    if args.n_speeds is not None and args.n_speeds < 2:
+        p.error(f"--n-speeds must be at least 2 (got {args.n_speeds})")
+    try:
+        mech = mechanism_from_args(args)
+        if not mech.clearance_joints:
+            raise ValueError(f"mechanism '{mech.name}' has no clearance joint to calibrate (see --clearance-at)")
+        options = options_from_args(args)
+        prep = prepare(mech, options)
+        speeds = np.geomspace(args.speeds[0], args.speeds[1], args.n_speeds or 8) if args.speeds else None
+        for j in mech.clearance_joints:
+            ring = prep.built.rings[j.name]
+            result, path = calibrate_joint(j, ring, prep.sizing[j.name], options, speeds=speeds,
+                                           use_cache=not args.no_cache)
+            files = calibration_report(result, j.clearance, ring, options, out_dir=args.out,
+                                       stem=f"calibration_{j.name}", title=f"Contact calibration: {j.name}",
+                                       source=str(path) if path else None)
+            print(files.markdown.read_text())
+            print(f"wrote {files.markdown} and {files.plot}")
+    except (ValueError, CalibrationStabilityError) as exc:
+        print(f"clearance calibrate: error: {exc}", file=sys.stderr)
+        return 2
+    return 0

@@ -1,0 +1,37 @@
+"""``clearance mjcf``: write the MuJoCo model (MJCF) of a scenario."""
+
+from __future__ import annotations
+
+import argparse
+from typing import Any
+
+from clearance.cli.options import (
+    add_scenario_args,
+    mechanism_from_args,
+    options_from_args,
+)
+
+__all__ = ["add_parser", "command"]
+
+
+def add_parser(sub: Any) -> None:
+    """Add ``mjcf`` to the subcommands ``sub`` (argparse's subparsers action)."""
+    m = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a scenario")
+    add_scenario_args(m)
+    m.add_argument("--out", default="model.xml", help="MJCF file to write (default model.xml)")
+    m.add_argument("--ideal", action="store_true", help="write the ideal twin instead")
+    m.set_defaults(run_command=command)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Write the model; returns the exit status."""
+    from clearance.results import atomic_write_text
+    from clearance.run.preparation import prepare
+
+    mech = mechanism_from_args(args)
+    if args.ideal:
+        mech = mech.ideal_twin()
+    prepared = prepare(mech, options_from_args(args))
+    atomic_write_text(args.out, prepared.to_xml())
+    print(f"wrote {args.out}")
+    return 0

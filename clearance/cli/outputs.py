@@ -1,0 +1,85 @@
+"""What ``clearance run`` and ``clearance reference`` write beside the arrays: summary, report, console lines."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+from clearance.model import Mechanism, OutputKind
+from clearance.results import SimulationResult
+
+__all__ = ["write_outputs", "duration_from_args"]
+
+
+def write_outputs(args: argparse.Namespace, mech: Mechanism, result: SimulationResult, ideal: SimulationResult,
+                  out: Path) -> None:
+    """Write arrays, summary CSV, the Markdown report with its figures (and a rerun recording).
+
+    Args:
+        args: the command's options (``rerun``: a recording path or None).
+        mech: the mechanism that ran.
+        result: its run.
+        ideal: the ideal twin's run.
+        out: output folder (exists).
+    """
+    from clearance.analysis.figures.report import write_report
+    from clearance.analysis.metrics.summary import summarise, write_summary_csv
+
+    result.save(out / "result")
+    ideal.save(out / "ideal")
+    period = mech.drive_period
+    # statistics skip the first drive period as start-up transient when the run is long enough;
+    # a mechanism driven by torques alone has no period: nothing is skipped
+    skip = period if period is not None and result.times[-1] > 2 * period else 0.0
+    if getattr(args, "rerun", None):
+        from clearance.analysis.figures.report import joint_sections
+        from clearance.analysis.recording.rerun_log import record
+
+        # the report's Poincaré sections (t = kT of the drive, after the same transient)
+        sections = joint_sections(result, skip=skip)
+        print(f"  wrote {record(result, mech, args.rerun, ideal=ideal, poincare=sections)}")
+    rows = summarise(result, ideal)
+    write_summary_csv(rows, out / "summary.csv")
+    write_report(out, result, ideal, skip=skip)
+    output = mech.outputs[0].name
+    angular = mech.outputs[0].kind is OutputKind.ANGLE
+    for r in rows:
+        if not r.max_penetration > 0:  # penetration = |e| - c never above 0: the journal never touched
+            print(f"  {r.joint}: no contact (the journal stayed at least {-r.max_penetration * 1e6:.3g} µm "
+                  "from the bearing)")
+            continue
+        print(f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
+              f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
+              f"max penetration {r.max_penetration * 1e6:.3g} µm")
+    if rows:
+        unit, scale = ("rad", 1.0) if angular else ("mm", 1e3)
+        print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * scale:.4g} {unit}")
+
+
+def duration_from_args(args: argparse.Namespace, mech: Mechanism, default_revolutions: float) -> float:
+    """Simulated time [s]: --duration-ms, else --revolutions of the slowest speed-driven crank.
+
+    Args:
+        args: the command's options (``duration_ms``, ``revolutions``).
+        mech: the mechanism to run.
+        default_revolutions: revolutions when neither option is given.
+
+    Returns:
+        The duration [s].
+
+    Raises:
+        ValueError: --revolutions for a mechanism driven by torques alone (it has no period).
+    """
+    from clearance.cli.options import si
+    from clearance.run.simulation import default_duration
+
+    if args.duration_ms:
+        return si(args.duration_ms, "ms")
+    if mech.drive_period is None:
+        if args.revolutions is not None:
+            raise ValueError(f"--revolutions {args.revolutions:g}: mechanism '{mech.name}' is driven by torques "
+                             "alone and has no drive period; give the simulated time with --duration-ms")
+        duration = default_duration(mech)
+        print(f"{mech.name} is driven by torques alone: simulating {duration:g} s (set it with --duration-ms)")
+        return duration
+    return default_duration(mech, default_revolutions if args.revolutions is None else args.revolutions)

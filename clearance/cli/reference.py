@@ -1,0 +1,75 @@
+"""``clearance reference``: a scenario with the exact-geometry reference solver (slow, exact)."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from clearance.cli.options import (
+    add_scenario_args,
+    mechanism_from_args,
+    numerics_given,
+    positive,
+    si,
+)
+from clearance.cli.outputs import duration_from_args, write_outputs
+
+__all__ = ["add_parser", "command"]
+
+
+def add_parser(sub: Any) -> None:
+    """Add ``reference`` to the subcommands ``sub`` (argparse's subparsers action)."""
+    f = sub.add_parser("reference", help="run a scenario with the exact-geometry reference solver (slow)")
+    add_scenario_args(f, numerics=False)  # MuJoCo numerics are refused (see command)
+    f.add_argument("--revolutions", type=positive(float, "--revolutions"), default=None,
+                   help="revolutions of the slowest speed-driven crank to simulate (default 1)")
+    f.add_argument("--duration-ms", type=positive(float, "--duration-ms"), default=None,
+                   help="simulated time [ms] (overrides --revolutions)")
+    f.add_argument("--rtol", type=positive(float, "--rtol"), default=1e-9, help="relative tolerance (default 1e-9)")
+    f.add_argument("--output-us", type=positive(float, "--output-us"), default=10.0,
+                   help="output interval [µs] (default 10)")
+    f.add_argument("--out", default="clearance-reference-out", help="output folder (default clearance-reference-out)")
+    f.add_argument("--rerun", default=None, metavar="PATH", help="also write a rerun recording (.rrd) to PATH")
+    f.add_argument("--no-progress", action="store_true", help="no progress bar")
+    f.set_defaults(run_command=command)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run ``clearance reference``; returns the exit status (2: refused or stopped by an error)."""
+    from clearance.reference import ReferenceSolverError, run_reference
+
+    given = numerics_given(args)
+    if given:
+        raise ValueError(
+            f"clearance reference does not take {', '.join(given)}: those are MuJoCo options, and the "
+            "reference solver has exact circle-in-circle geometry (no segments or geoms), applies each "
+            "joint's contact law exactly (no contact mode) and takes adaptive steps (no time step); "
+            "set its accuracy with --rtol and its output interval with --output-us"
+        )
+    mech = mechanism_from_args(args)
+    duration = duration_from_args(args, mech, 1.0)
+    out = Path(args.out)
+    interval = si(args.output_us, "us")
+    print(f"{mech.name} (reference solver): clearance at {[j.name for j in mech.clearance_joints]}, "
+          f"{duration * 1e3:.3g} ms, rtol {args.rtol:g}")
+    progress = not args.no_progress
+    failed = None
+    try:
+        result = run_reference(mech, duration, output_interval=interval, rtol=args.rtol, progress=progress)
+    except ReferenceSolverError as err:
+        failed, partial = err, getattr(err, "partial", None)
+        if partial is None:
+            print(f"error: {failed}", file=sys.stderr)
+            return 2
+        result = partial
+    print(f"  ideal twin (no clearance), {duration * 1e3:.3g} ms, for the deviations")
+    ideal = run_reference(mech.ideal_twin(), duration, output_interval=interval, rtol=args.rtol, progress=progress)
+    out.mkdir(parents=True, exist_ok=True)
+    write_outputs(args, mech, result, ideal, out)
+    print(f"  wall time {result.metadata.get('wall_time_s', float('nan')):.3g} s; wrote {out}/")
+    if failed is not None:
+        print(f"error: {failed}", file=sys.stderr)
+        return 2
+    return 0

@@ -1,0 +1,69 @@
+"""``clearance run``: simulate a scenario in MuJoCo and write arrays, summary, report, figures, models."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from clearance.cli.options import (
+    add_scenario_args,
+    mechanism_from_args,
+    options_from_args,
+    positive,
+)
+from clearance.cli.outputs import duration_from_args, write_outputs
+
+__all__ = ["add_parser", "command"]
+
+
+def add_parser(sub: Any) -> None:
+    """Add ``run`` to the subcommands ``sub`` (argparse's subparsers action)."""
+    r = sub.add_parser("run", help="simulate a scenario and write results, figures and the model")
+    add_scenario_args(r)
+    r.add_argument("--revolutions", type=positive(float, "--revolutions"), default=None,
+                   help="revolutions of the slowest speed-driven crank to simulate (default 3)")
+    r.add_argument("--duration-ms", type=positive(float, "--duration-ms"), default=None,
+                   help="simulated time [ms] (overrides --revolutions)")
+    r.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
+    r.add_argument("--no-progress", action="store_true", help="no progress bar")
+    r.add_argument("--rerun", default=None, metavar="PATH",
+                   help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH")
+    r.set_defaults(run_command=command)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run ``clearance run``; returns the exit status (2: refused or stopped by an error)."""
+    from clearance.results import atomic_write_text
+    from clearance.run.preparation import prepare
+    from clearance.run.simulation import SimulationError, simulate_prepared
+
+    mech = mechanism_from_args(args)
+    options = options_from_args(args)
+    duration = duration_from_args(args, mech, 3.0)
+    out = Path(args.out)
+    prepared = prepare(mech, options)
+    ideal_prepared = prepare(mech.ideal_twin(), options)
+    out.mkdir(parents=True, exist_ok=True)  # only once the models are built: a refused run leaves no folder
+    atomic_write_text(out / "model.xml", prepared.to_xml())
+    atomic_write_text(out / "ideal_model.xml", ideal_prepared.to_xml())
+    print(f"{mech.name}: clearance at {[j.name for j in mech.clearance_joints]}, "
+          f"{duration * 1e3:.3g} ms at h = {options.timestep:g} s, segments {prepared.metadata['segments']}")
+    progress = not args.no_progress
+    failed = None
+    try:
+        result = simulate_prepared(prepared, duration=duration, progress=progress)
+    except SimulationError as err:
+        failed, partial = err, err.partial
+        if partial is None:
+            print(f"error: {failed}", file=sys.stderr)
+            return 2
+        result = partial
+    ideal = simulate_prepared(ideal_prepared, duration=duration, progress=progress)
+    write_outputs(args, mech, result, ideal, out)
+    print(f"  {result.metadata['steps_per_second']:.3g} steps/s; wrote {out}/")
+    if failed is not None:
+        print(f"error: {failed}", file=sys.stderr)
+        return 2
+    return 0

@@ -1,0 +1,393 @@
+"""`simulate`: run a mechanism in MuJoCo with `mujoco.rollout`, no Python per step.
+
+The run is stepped in chunks (bounded memory); after each chunk MuJoCo's warning counters,
+non-finite values and every journal's penetration are checked. A run that goes unstable
+stops with `SimulationError`, which names the time, the joint (when a journal went beyond
+its bound; None when the cause is the model's state as a whole) and a remedy, and carries
+the result computed up to the last good step: the rows before the first bad one.
+"""
+
+from __future__ import annotations
+
+import time as _time
+from collections.abc import Callable, Mapping
+
+import mujoco
+import numpy as np
+from mujoco import rollout
+
+from clearance.model import DriveKind, Mechanism
+from clearance.options import ContactMode, ContactParameters, ModelOptions
+from clearance.run.preparation import PreparedModel, prepare
+from clearance.run.readout import read_sensors
+from clearance.version import __version__
+
+__all__ = ["SimulationError", "simulate", "simulate_prepared", "default_duration"]
+
+
+class SimulationError(RuntimeError):
+    """A run diverged.
+
+    Attributes:
+        partial: the result up to the last good step (None when there is none).
+        time: time of the first bad step [s].
+        joint: the clearance joint whose journal went beyond its divergence bound, or None
+            when the cause cannot be tied to one joint (a non-finite state, a MuJoCo warning).
+    """
+
+    def __init__(self, message: str, partial=None, *, time: float | None = None, joint: str | None = None):
+        super().__init__(message)
+        self.partial = partial
+        self.time = time
+        self.joint = joint
+
+
+def default_duration(mechanism: Mechanism, revolutions: float = 3.0) -> float:
+    """``revolutions`` periods of the slowest prescribed drive [s] (1 s if none)."""
+    period = mechanism.drive_period
+    return revolutions * period if period is not None else 1.0
+
+
+def _controls(mechanism: Mechanism, times: np.ndarray) -> np.ndarray:
+    """(len(times), n_drives) actuator controls: drive speed, or torque."""
+    out = np.empty((len(times), len(mechanism.drives)))
+    for k, d in enumerate(mechanism.drives):
+        out[:, k] = d.torque if d.kind is DriveKind.TORQUE else d.rate(times)
+    return out
+
+
+def _constant_controls(mechanism: Mechanism) -> bool:
+    return all(d.kind is not DriveKind.MOTION_LAW for d in mechanism.drives)
+
+
+def simulate(
+    mechanism: Mechanism,
+    *,
+    duration: float | None = None,
+    options: ModelOptions | None = None,
+    output_interval: float | None = None,
+    contact: dict[str, ContactParameters] | None = None,
+    progress: bool | Callable[[float], None] = False,
+    chunk_steps: int = 100_000,
+    initial_eccentricity: Mapping[str, tuple[float, float]] | None = None,
+):
+    """Simulate a mechanism with clearance joints in MuJoCo.
+
+    Args:
+        mechanism: the mechanism.
+        duration: simulated time [s]; default 3 periods of the slowest drive.
+        options: numerical options (default `ModelOptions()`).
+        output_interval: interval of stored rows [s]; default every step. Peaks and event
+            statistics should be taken from full-rate data: keep the default for them.
+        contact: per-joint contact parameters overriding the contact mode's.
+        progress: True for a progress bar on stderr, or a callable receiving the fraction
+            done (0..1) after each chunk.
+        chunk_steps: steps per `mujoco.rollout` call (memory bound).
+        initial_eccentricity: clearance joint name -> (e_x, e_y) [m] journal centre in the
+            bearing frame at t = 0 (default: centred). The other coordinates change as
+            little as the loop closures and drive angles allow; velocities stay ideal.
+
+    Returns:
+        SimulationResult (times, outputs, per-joint eccentricity / penetration / force,
+        drive angle / speed / torque, link poses, closure violation, metadata).
+
+    Raises:
+        ValueError: bad arguments (before any work).
+        AssemblyError: the mechanism cannot be assembled at t = 0.
+        TimeStepError: the time step is too large for the contact stiffness.
+        SimulationError: the run diverged (partial result attached).
+    """
+    options = options or ModelOptions()
+    if duration is None:
+        duration = default_duration(mechanism)
+    if not (isinstance(duration, (int, float)) and np.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be a positive number of seconds (got {duration!r})")
+    if output_interval is not None and not (np.isfinite(output_interval) and output_interval > 0):
+        raise ValueError(f"output_interval must be > 0 s (got {output_interval!r})")
+    if not isinstance(chunk_steps, int) or chunk_steps < 1:
+        raise ValueError(f"chunk_steps must be a positive integer (got {chunk_steps!r})")
+    if initial_eccentricity is not None:
+        names = {j.name for j in mechanism.clearance_joints}
+        for k, v in dict(initial_eccentricity).items():
+            if k not in names:
+                raise ValueError(f"initial_eccentricity: '{k}' is not a clearance joint (clearance joints: {sorted(names)})")
+            if not (len(v) == 2 and all(np.isfinite(x) for x in v)):
+                raise ValueError(f"initial_eccentricity['{k}'] must be (e_x, e_y) in metres (got {v!r})")
+    prepared = prepare(mechanism, options, contact=contact)
+    return simulate_prepared(
+        prepared, duration=duration, output_interval=output_interval, progress=progress, chunk_steps=chunk_steps,
+        initial_eccentricity=initial_eccentricity,
+    )
+
+
+def simulate_prepared(
+    prepared: PreparedModel,
+    *,
+    duration: float,
+    output_interval: float | None = None,
+    progress: bool | Callable[[float], None] = False,
+    chunk_steps: int = 100_000,
+    initial_eccentricity: Mapping[str, tuple[float, float]] | None = None,
+):
+    """Run an already prepared model (see `simulate` for the arguments)."""
+    from clearance.results import SimulationResult
+
+    model, mech = prepared.model, prepared.mechanism
+    h = model.opt.timestep
+    nstep = int(round(duration / h))
+    every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
+    qpos0 = _initial_qpos(prepared, initial_eccentricity)
+    # exact-LN mode imposes LN on clearance joints' rows; a model without any (the ideal
+    # twin) has nothing to impose and runs in the rollout
+    exact = prepared.options.contact_mode is ContactMode.EXACT_LN and bool(mech.clearance_joints)
+    step = _exact_ln_stepper(prepared, qpos0) if exact else _rollout_stepper(prepared, qpos0)
+    constant = _constant_controls(mech)
+    bar = _progress(progress, nstep)
+    parts: list[SimulationResult] = []
+    t0 = _time.perf_counter()
+    done = 0
+    while done < nstep:
+        n = min(chunk_steps, nstep - done)
+        times = (done + np.arange(n)) * h
+        ctrl = _controls(mech, times[:1] if constant else times)
+        failure = None
+        try:
+            states, sens, data = step(ctrl, n)
+        except _StepFailure as fail:
+            states, sens, data, failure = fail.states, fail.sens, fail.data, fail.reason
+        part = read_sensors(prepared, times[: len(sens)], sens)
+        # a stepper that stopped early has placed its warning at the step: only rows before it came back
+        bad = _first_bad(prepared, data, part, states, sens, warnings=failure is None)
+        if failure is not None and (bad is None or bad[0] >= len(sens)):
+            # the stepper stopped at its first bad step: all rows it returned are good
+            bad = (len(sens), None, failure, _remedy(prepared))
+        if bad is not None:
+            idx, joint, why, remedy = bad
+            parts.append(_thin(part.sliced(slice(0, idx)), done, every))
+            result = _finish(parts, prepared, t0, nstep_done=done + idx, every=every)
+            tb = float(times[min(idx, n - 1)])
+            raise SimulationError(
+                f"simulation diverged at t = {tb:.6g} s{f' at joint {joint!r}' if joint else ''}: {why}. "
+                f"Remedy: {remedy}. The result up to t = {tb:.6g} s is attached as .partial.",
+                result,
+                time=tb,
+                joint=joint,
+            )
+        parts.append(_thin(part, done, every))
+        done += n
+        bar(done)
+    bar(None)
+    return _finish(parts, prepared, t0, nstep_done=nstep, every=every)
+
+
+def _thin(part, first_step: int, every: int):
+    """Rows of a chunk starting at step ``first_step`` whose step index is a multiple of ``every``.
+
+    Thinning each chunk as it comes keeps memory bounded by the stored rows, not the steps.
+    """
+    return part if every == 1 else part.sliced(slice((-first_step) % every, None, every))
+
+
+class _StepFailure(Exception):
+    """A stepper stopped at its first bad step; carries the rows before it and the reason."""
+
+    def __init__(self, states, sens, data, reason: str):
+        super().__init__(reason)
+        self.states, self.sens, self.data, self.reason = states, sens, data, reason
+
+
+def _initial_qpos(prepared: PreparedModel, targets) -> np.ndarray | None:
+    """qpos with journals moved to ``targets`` (None: the keyframe's)."""
+    if not targets:
+        return None
+    from clearance.run.initial_state import offset_journals
+
+    model, mech = prepared.model, prepared.mechanism
+    for k, v in targets.items():
+        c = mech.joint(k).clearance.radial_clearance
+        lim = prepared.sizing[k].penetration_limit
+        if np.hypot(*v) > c + lim:
+            raise ValueError(
+                f"initial_eccentricity['{k}'] = {tuple(v)} m puts the journal {np.hypot(*v) - c:.3g} m into its "
+                f"bearing, beyond the divergence bound {lim:.3g} m; expected |e| <= c + bound = {c + lim:.4g} m"
+            )
+    return offset_journals(
+        model, model.key_qpos[0], targets,
+        bearings={k: mech.joint(k).clearance.radial_clearance for k in targets},
+        fixed_joints=[d.joint for d in mech.drives],
+    )
+
+
+def _start(model: mujoco.MjModel, qpos0: np.ndarray | None) -> mujoco.MjData:
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, 0)
+    if qpos0 is not None:
+        data.qpos[:] = qpos0
+    return data
+
+
+def _rollout_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
+    """Chunks with `mujoco.rollout` (no Python per step)."""
+    model = prepared.model
+    data = _start(model, qpos0)
+    kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    state = np.empty(mujoco.mj_stateSize(model, kind))
+    mujoco.mj_getState(model, data, state, kind)
+    box = {"state": state}
+
+    def step(ctrl: np.ndarray, n: int):
+        start, before = box["state"], _warning_count(data)
+        states, sens = rollout.rollout(model, data, start[None], ctrl[None], nstep=n)
+        states, sens = states[0], sens[0]
+        box["state"] = states[-1]
+        if _warning_count(data) > before and np.isfinite(states).all() and np.isfinite(sens).all():
+            # a warning without a non-finite value (a huge acceleration, a full contact
+            # buffer) says nothing about when: step the chunk again to find the step
+            k, fired = _first_warning_step(model, start, ctrl, n)
+            raise _StepFailure(states[:k], sens[:k], data, f"MuJoCo raised warnings {fired}")
+        return states, sens, data
+
+    return step
+
+
+def _warning_count(data: mujoco.MjData) -> int:
+    return int(sum(data.warning[i].number for i in range(mujoco.mjtWarning.mjNWARNING.value)))
+
+
+def _first_warning_step(model: mujoco.MjModel, state: np.ndarray, ctrl: np.ndarray, n: int) -> tuple[int, list[str]]:
+    """(index of the first step of a chunk that raises a MuJoCo warning, the warnings' names).
+
+    Replays the chunk from its initial full-physics state with `mujoco.mj_step` (the
+    stepping rollout does; only on this error path). ``ctrl``: (1, nu) held or (n, nu).
+    """
+    data = mujoco.MjData(model)
+    mujoco.mj_setState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    for k in range(n):
+        data.ctrl[:] = ctrl[min(k, len(ctrl) - 1)]
+        mujoco.mj_step(model, data)
+        if _warning_count(data):
+            break
+    fired = [mujoco.mjtWarning(i).name for i in range(mujoco.mjtWarning.mjNWARNING.value) if data.warning[i].number]
+    return k, fired
+
+
+def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
+    """Chunks with the exact-LN step loop (LN force imposed on the ring rows each step)."""
+    import copy
+
+    from clearance.contact_calibration.exact_ln import (
+        ExactLNContact,
+        ExactLNStepError,
+        step_exact_ln,
+    )
+
+    model = copy.copy(prepared.model)  # ExactLNContact raises pair margins in place
+    for j in prepared.mechanism.clearance_joints:
+        if j.clearance.friction > 0:
+            raise ValueError(
+                f"contact_mode 'exact_ln' supports frictionless joints only (joint '{j.name}' has "
+                f"friction {j.clearance.friction}); use 'calibrated'"
+            )
+    contacts = [
+        ExactLNContact(model, j.clearance, prepared.built.rings[j.name], journal_geom=f"{j.name}__journal",
+                       bearing_site=f"{j.name}__bearing")
+        for j in prepared.mechanism.clearance_joints
+    ]
+    data = _start(model, qpos0)
+
+    def step(ctrl: np.ndarray, n: int):
+        try:
+            run = step_exact_ln(model, data, contacts, n, ctrl=ctrl if len(ctrl) == n else ctrl[0])
+        except ExactLNStepError as err:
+            run = err.partial  # the steps before the failing one
+            raise _StepFailure(np.hstack([run.qpos, run.qvel]), run.sensordata, data, err.reason) from err
+        return np.hstack([run.qpos, run.qvel]), run.sensordata, data
+
+    return step
+
+
+def _remedy(prepared: PreparedModel) -> str:
+    h = prepared.options.timestep
+    return (
+        f"use a smaller time step (now {h:g} s, try {h / 2:g} s) or more bearing segments "
+        f"(ModelOptions(segments=...))"
+    )
+
+
+def _finish(parts, prepared: PreparedModel, t0: float, *, nstep_done: int, every: int):
+    from clearance.results import SimulationResult
+
+    if not parts:
+        return None
+    res = SimulationResult.concatenate(parts)
+    wall = _time.perf_counter() - t0
+    mech = prepared.mechanism
+    res.metadata = {
+        **prepared.metadata,
+        "solver": "mujoco",
+        "mechanism": mech.name,
+        "parameters": dict(mech.parameters),
+        "clearance_joints": [j.name for j in mech.clearance_joints],
+        "drives": [d.name for d in mech.drives],
+        "links": [lk.name for lk in mech.moving_links],
+        "steps": nstep_done,
+        "output_every_steps": every,
+        "wall_time_s": wall,
+        "steps_per_second": nstep_done / wall if wall > 0 else None,
+        "mujoco_version": mujoco.__version__,
+        "package_version": __version__,
+    }
+    return res
+
+
+def _first_bad(prepared: PreparedModel, data: mujoco.MjData, part, states: np.ndarray, sens: np.ndarray, *,
+               warnings: bool = True):
+    """(row index, joint or None, reason, remedy) of a chunk's first bad row, or None.
+
+    Rows from the index on are dropped. A row is bad when its journal is beyond the
+    divergence bound (that joint is named) or its state or sensors are not finite (no
+    joint is named: the cause cannot be tied to one). State row i is after step i and
+    sensor row i before it, so a step that goes non-finite drops its own row. With
+    ``warnings``, MuJoCo warnings the stepper could not place drop the whole chunk.
+    """
+    n = len(part.times)
+    finite = np.isfinite(states[:n]).all(axis=1) & np.isfinite(sens[:n]).all(axis=1)
+    first_nan = int(np.argmin(finite)) if not finite.all() else n
+    worst = (n, None, None)
+    for name, jr in part.joints.items():
+        lim = prepared.sizing[name].penetration_limit
+        over = np.nonzero(jr.penetration > lim)[0]
+        if len(over) and over[0] < worst[0]:
+            worst = (int(over[0]), name, float(jr.penetration[over[0]]))
+    remedy = _remedy(prepared)
+    if worst[1] is not None and worst[0] <= first_nan:
+        lim = prepared.sizing[worst[1]].penetration_limit
+        return worst[0], worst[1], (
+            f"the journal penetrated {worst[2] * 1e6:.3g} um into its bearing, beyond the bound "
+            f"{lim * 1e6:.3g} um (4 x the Hertz penetration of the expected hardest impact)"
+        ), remedy
+    if first_nan < n:
+        return first_nan, None, "the state became non-finite (NaN or Inf)", remedy
+    fired = [mujoco.mjtWarning(i).name for i in range(mujoco.mjtWarning.mjNWARNING.value) if data.warning[i].number > 0]
+    if warnings and fired:
+        # a stepper that could not say when: keep only what preceded the chunk
+        return 0, None, f"MuJoCo raised warnings {fired} during this chunk", remedy
+    return None
+
+
+def _progress(progress, total: int):
+    if callable(progress):
+        return lambda done: progress(1.0 if done is None else done / total)
+    if not progress:
+        return lambda done: None
+    from tqdm import tqdm
+
+    bar = tqdm(total=total, unit="step", unit_scale=True, desc="simulate", leave=False)
+
+    def update(done):
+        if done is None:
+            bar.close()
+        else:
+            bar.update(done - bar.n)
+
+    return update
