@@ -21,6 +21,6 @@ def write_keeping_reading(path: str | Path, generated: str) -> str:
     """
     p = Path(path)
     old = p.read_text(encoding="utf-8") if p.exists() else ""
-    text = generated + (old[old.index(READING):] if READING in old else "")
+    text = generated + (old[old.index(READING) :] if READING in old else "")
     atomic_write_text(p, text)
     return text

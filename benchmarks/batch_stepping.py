@@ -37,9 +37,9 @@ from _states import (
     keyframe_state,  # benchmarks/_states.py (scripts run from benchmarks/)
 )
 from _tables import write_keeping_reading
-from clearance.builders import rpm, slider_crank
 from mujoco import rollout
 
+from clearance.builders import rpm, slider_crank
 from clearance.options import ModelOptions
 from clearance.run.preparation import prepare
 
@@ -52,8 +52,9 @@ def _point(clearance: float, h: float, nstep: int) -> float:
     """Prepare and step one point as a sweep worker does; returns its final slider x [m]."""
     prepared = prepare(slider_crank(radial_clearance=clearance), _options(h))
     state, ctrl = keyframe_state(prepared.model)
-    states, _ = rollout.rollout(prepared.model, mujoco.MjData(prepared.model), state[None],
-                                np.tile(ctrl, (1, 1, 1)), nstep=nstep)
+    states, _ = rollout.rollout(
+        prepared.model, mujoco.MjData(prepared.model), state[None], np.tile(ctrl, (1, 1, 1)), nstep=nstep
+    )
     return float(states[0, -1, 1])
 
 
@@ -87,8 +88,12 @@ def main(argv: list[str] | None = None) -> int:
     ctrl = np.stack([c for _, c in init])[:, None, :]
 
     def one_by_one():
-        return np.stack([rollout.rollout(m, mujoco.MjData(m), s[None], c[None], nstep=nstep)[0][0]
-                         for m, s, c in zip(models, states0, ctrl)])
+        return np.stack(
+            [
+                rollout.rollout(m, mujoco.MjData(m), s[None], c[None], nstep=nstep)[0][0]
+                for m, s, c in zip(models, states0, ctrl)
+            ]
+        )
 
     def batched(nthread: int):
         datas = [mujoco.MjData(models[0]) for _ in range(nthread)]
@@ -101,8 +106,7 @@ def main(argv: list[str] | None = None) -> int:
 
     t0 = time.perf_counter()
     with ProcessPoolExecutor(2, mp_context=get_context("spawn")) as pool:
-        final = list(pool.map(_point, [float(c) for c in clearances], [h] * len(clearances),
-                              [nstep] * len(clearances)))
+        final = list(pool.map(_point, [float(c) for c in clearances], [h] * len(clearances), [nstep] * len(clearances)))
     t_d = time.perf_counter() - t0
     same_pool = bool(np.array_equal(np.asarray(final), s_a[:, -1, 1]))
     load1 = os.getloadavg()[0]

@@ -22,11 +22,11 @@ import time
 from pathlib import Path
 
 import numpy as np
+
 from clearance.analysis.figures.analysis_figures import plot_bifurcation
 from clearance.analysis.sweeps.bifurcation import run_bifurcation
 from clearance.analysis.sweeps.sweep import KeywordFactory
 from clearance.builders import slider_crank
-
 from clearance.options import ModelOptions
 
 
@@ -35,8 +35,10 @@ def compare(dir_a: str, dir_b: str) -> None:
     from clearance.analysis.sweeps.sweep import load_rows
 
     rows_b = {round(r["point"]["radial_clearance"], 12): r for r in load_rows(dir_b)}
-    print("| c [mm] | regime A | regime B | peak force A [kN] | peak force B [kN] | mean ex A [µm] | mean ex B [µm] "
-          "| std ex A [µm] | std ex B [µm] |")
+    print(
+        "| c [mm] | regime A | regime B | peak force A [kN] | peak force B [kN] | mean ex A [µm] | mean ex B [µm] "
+        "| std ex A [µm] | std ex B [µm] |"
+    )
     print("|---:|---|---|---:|---:|---:|---:|---:|---:|")
     agree, ratios = 0, []
     for ra in load_rows(dir_a):
@@ -49,10 +51,14 @@ def compare(dir_a: str, dir_b: str) -> None:
         ga, gb = ra["poincare"]["regime"], rb["poincare"]["regime"]
         agree += ga == gb
         ratios.append(fa / fb)
-        print(f"| {c * 1e3:.3f} | {ga} | {gb} | {fa / 1e3:.2f} | {fb / 1e3:.2f} | {xa.mean():.1f} | {xb.mean():.1f} "
-              f"| {xa.std():.1f} | {xb.std():.1f} |")
-    print(f"regimes agree at {agree}/{len(ratios)} points; peak force ratio A/B median {np.median(ratios):.3f}, "
-          f"range {min(ratios):.3f}-{max(ratios):.3f}")
+        print(
+            f"| {c * 1e3:.3f} | {ga} | {gb} | {fa / 1e3:.2f} | {fb / 1e3:.2f} | {xa.mean():.1f} | {xb.mean():.1f} "
+            f"| {xa.std():.1f} | {xb.std():.1f} |"
+        )
+    print(
+        f"regimes agree at {agree}/{len(ratios)} points; peak force ratio A/B median {np.median(ratios):.3f}, "
+        f"range {min(ratios):.3f}-{max(ratios):.3f}"
+    )
 
 
 def main() -> None:
@@ -74,8 +80,16 @@ def main() -> None:
     values = np.linspace(0.01e-3, 1e-3, args.points)[:: args.every]
     opts = ModelOptions(timestep=args.timestep_us * 1e-6, segments=args.segments, contact_mode=args.contact_mode)
     t0 = time.perf_counter()
-    d = run_bifurcation(values, KeywordFactory(slider_crank), out_dir=args.out, quantity="rod_slider.ex",
-                        periods=args.periods, sampled=args.sampled, options=opts, max_workers=args.workers)
+    d = run_bifurcation(
+        values,
+        KeywordFactory(slider_crank),
+        out_dir=args.out,
+        quantity="rod_slider.ex",
+        periods=args.periods,
+        sampled=args.sampled,
+        options=opts,
+        max_workers=args.workers,
+    )
     wall = time.perf_counter() - t0
     plot_bifurcation(d, path=Path(args.out) / "bifurcation.png")
     rows = [json.loads(f.read_text()) for f in sorted((Path(args.out) / "points").glob("*.json"))]
@@ -86,17 +100,30 @@ def main() -> None:
         return round(sum(r["timing"].get(key) or 0.0 for r in rows), 1)
 
     stepping = total("stepping_s")
-    print(json.dumps({
-        "machine": f"{platform.machine()}, {args.workers} workers",
-        "points": len(d.values), "timestep_us": args.timestep_us, "segments": args.segments or "ripple rule",
-        "contact_mode": args.contact_mode,
-        "wall_s": round(wall, 1), "per_point_s_median": round(statistics.median(per), 2),
-        "per_point_s_max": round(max(per), 2), "regimes": counts,
-        "worker_s": {"points": total("wall_time_s"), "stepping": stepping,
-                     "preparation": round(total("simulate_s") - stepping, 1), "ideal": total("ideal_s"),
-                     "evaluation": total("evaluate_s")},
-        "errors": sorted({e.split(':')[0] for e in d.errors if e}),
-    }, indent=1))
+    print(
+        json.dumps(
+            {
+                "machine": f"{platform.machine()}, {args.workers} workers",
+                "points": len(d.values),
+                "timestep_us": args.timestep_us,
+                "segments": args.segments or "ripple rule",
+                "contact_mode": args.contact_mode,
+                "wall_s": round(wall, 1),
+                "per_point_s_median": round(statistics.median(per), 2),
+                "per_point_s_max": round(max(per), 2),
+                "regimes": counts,
+                "worker_s": {
+                    "points": total("wall_time_s"),
+                    "stepping": stepping,
+                    "preparation": round(total("simulate_s") - stepping, 1),
+                    "ideal": total("ideal_s"),
+                    "evaluation": total("evaluate_s"),
+                },
+                "errors": sorted({e.split(":")[0] for e in d.errors if e}),
+            },
+            indent=1,
+        )
+    )
 
 
 if __name__ == "__main__":

@@ -30,6 +30,7 @@ import numpy as np
 from _states import (
     keyframe_state,  # benchmarks/_states.py (scripts run from benchmarks/)
 )
+
 from clearance.builders import slider_crank
 from clearance.contact_calibration import clearance_impact
 from clearance.contact_calibration.effective_mass import cycle_effective_mass
@@ -37,7 +38,6 @@ from clearance.contact_calibration.exact_ln import exact_ln_cost, exact_ln_impac
 from clearance.contact_calibration.fit import GOALS, accuracy_rows, default_speeds
 from clearance.contact_calibration.report import accuracy_table
 from clearance.contact_calibration.store import calibrate
-
 from clearance.options import ModelOptions
 from clearance.run.preparation import prepare
 
@@ -73,17 +73,21 @@ small in this design) or the exact-LN mode below are the ways past these limits.
 def _misses(rows) -> str:
     """Plain-text list of the goals missed: metric, speeds, largest excess over the goal."""
     out = []
-    for name, attr, goal, pct in (("peak force", "peak_force_worst", GOALS["peak_force"], True),
-                                  ("max penetration", "max_penetration_worst", GOALS["max_penetration"], True),
-                                  ("duration", "duration_worst", GOALS["duration"], True),
-                                  ("restitution", "restitution_worst", GOALS["restitution"], False)):
+    for name, attr, goal, pct in (
+        ("peak force", "peak_force_worst", GOALS["peak_force"], True),
+        ("max penetration", "max_penetration_worst", GOALS["max_penetration"], True),
+        ("duration", "duration_worst", GOALS["duration"], True),
+        ("restitution", "restitution_worst", GOALS["restitution"], False),
+    ):
         bad = [(r.speed, getattr(r, attr)) for r in rows if abs(getattr(r, attr)) > goal]
         if bad:
             worst = max(bad, key=lambda b: abs(b[1]))
             val = f"{worst[1] * 100:+.2f} %" if pct else f"{worst[1]:+.4f}"
             lim = f"{goal:.0%}" if pct else f"{goal}"
-            out.append(f"{name} at {', '.join(f'{v:.3g}' for v, _ in bad)} m/s (worst {val} at "
-                       f"{worst[0]:.3g} m/s against ±{lim})")
+            out.append(
+                f"{name} at {', '.join(f'{v:.3g}' for v, _ in bad)} m/s (worst {val} at "
+                f"{worst[0]:.3g} m/s against ±{lim})"
+            )
     return "; ".join(out) if out else "none"
 
 
@@ -101,18 +105,24 @@ def _case(title: str, mech, *, speeds=None, cycle: bool = False, eval_speeds=EVA
         mass, mrange = em.median, em.valid_range
     fit_speeds = speeds if speeds is not None else default_speeds(s.impact_speed)
     t0 = time.perf_counter()
-    res, _ = calibrate(j.clearance, ring, opts, mass=mass, speeds=fit_speeds, mass_range=mrange,
-                       max_penetration=s.penetration_limit)
+    res, _ = calibrate(
+        j.clearance, ring, opts, mass=mass, speeds=fit_speeds, mass_range=mrange, max_penetration=s.penetration_limit
+    )
     wall = time.perf_counter() - t0
-    rows = accuracy_rows(j.clearance, ring, opts, res.parameters, mass=mass,
-                         speeds=fit_speeds if eval_speeds is None else eval_speeds)
-    where = (f"{fit_speeds[0]:.3g}–{fit_speeds[-1]:.3g} m/s (the fitted speeds)" if eval_speeds is None
-             else f"{eval_speeds[0]:.3g}–{eval_speeds[-1]:.3g} m/s")
+    rows = accuracy_rows(
+        j.clearance, ring, opts, res.parameters, mass=mass, speeds=fit_speeds if eval_speeds is None else eval_speeds
+    )
+    where = (
+        f"{fit_speeds[0]:.3g}–{fit_speeds[-1]:.3g} m/s (the fitted speeds)"
+        if eval_speeds is None
+        else f"{eval_speeds[0]:.3g}–{eval_speeds[-1]:.3g} m/s"
+    )
     p = res.parameters
     head = (
         f"### {title}\n\n"
         f"c = {j.clearance.radial_clearance * 1e3:g} mm, N = {ring.segments}, effective mass "
-        f"{mass:.4g} kg" + (f" (cycle range {mrange[0]:.4g}–{mrange[1]:.4g} kg)" if mrange else " (qpos0)")
+        f"{mass:.4g} kg"
+        + (f" (cycle range {mrange[0]:.4g}–{mrange[1]:.4g} kg)" if mrange else " (qpos0)")
         + f"; fitted over {fit_speeds[0]:.3g}–{fit_speeds[-1]:.3g} m/s ({len(fit_speeds)} speeds × 2 "
         f"directions) in {wall:.1f} s ({res.nfev} MuJoCo evaluations): per-row k = {p.stiffness:.5g} N/m, "
         f"b = {p.damping:.5g} N·s/m (nominal {res.initial.stiffness:.5g}, {res.initial.damping:.5g}); "
@@ -121,22 +131,33 @@ def _case(title: str, mech, *, speeds=None, cycle: bool = False, eval_speeds=EVA
         f"goals. At {where}:\n\n"
     )
     tail = f"\nGoals missed: {_misses(rows)}.\n"
-    return head + accuracy_table(rows) + tail, {"rows": rows, "ring": ring, "joint": j, "mass": mass,
-                                         "opts": opts, "params": p}
+    return head + accuracy_table(rows) + tail, {
+        "rows": rows,
+        "ring": ring,
+        "joint": j,
+        "mass": mass,
+        "opts": opts,
+        "params": p,
+    }
 
 
 def _fit_range_check() -> str:
     """The fit range's top speed (an estimate) against the fastest contact onset of a run."""
     from clearance.builders import rpm
-
     from clearance.run.simulation import simulate
 
-    cases = {"default": slider_crank(), "c = 0.01 mm": slider_crank(radial_clearance=1e-5),
-             "c = 0.1 mm": slider_crank(radial_clearance=1e-4), "c = 1 mm": slider_crank(radial_clearance=1e-3),
-             "10,000 rpm": slider_crank(crank_speed=rpm(10000)),
-             "200 rpm, gravity": slider_crank(crank_speed=rpm(200), gravity=9.81)}
-    lines = ["| scenario | fit range top (estimate) [m/s] | fastest onset in one revolution [m/s] | "
-             "estimate / measured |", "|---|---:|---:|---:|"]
+    cases = {
+        "default": slider_crank(),
+        "c = 0.01 mm": slider_crank(radial_clearance=1e-5),
+        "c = 0.1 mm": slider_crank(radial_clearance=1e-4),
+        "c = 1 mm": slider_crank(radial_clearance=1e-3),
+        "10,000 rpm": slider_crank(crank_speed=rpm(10000)),
+        "200 rpm, gravity": slider_crank(crank_speed=rpm(200), gravity=9.81),
+    }
+    lines = [
+        "| scenario | fit range top (estimate) [m/s] | fastest onset in one revolution [m/s] | estimate / measured |",
+        "|---|---:|---:|---:|",
+    ]
     for name, mech in cases.items():
         opts = ModelOptions(timestep=TIMESTEP, contact_mode="nominal", segments=144)
         prep = prepare(mech, opts)
@@ -159,16 +180,22 @@ def _exact(info: dict) -> str:
         ref = clearance_impact(j.clearance, mass=m, speed=float(v))
         errs = []
         for frac in (0.0, 0.5, 0.3):
-            imp = exact_ln_impact(j.clearance, ring, opts, mass=m, speed=float(v),
-                                  direction=frac * 2 * math.pi / ring.segments)
-            errs.append([imp.peak_force / ref.peak_force - 1, imp.max_penetration / ref.max_penetration - 1,
-                         imp.duration / ref.duration - 1, imp.restitution - ref.restitution])
+            imp = exact_ln_impact(
+                j.clearance, ring, opts, mass=m, speed=float(v), direction=frac * 2 * math.pi / ring.segments
+            )
+            errs.append(
+                [
+                    imp.peak_force / ref.peak_force - 1,
+                    imp.max_penetration / ref.max_penetration - 1,
+                    imp.duration / ref.duration - 1,
+                    imp.restitution - ref.restitution,
+                ]
+            )
         e = np.array(errs)
         w = e[np.argmax(np.abs(e), axis=0), np.arange(4)]
         worst = np.maximum(worst, np.abs(w))
         lines.append(f"| {v:.3g} | {w[0] * 100:+.3f} % | {w[1] * 100:+.3f} % | {w[2] * 100:+.3f} % | {w[3]:+.5f} |")
-    cost = exact_ln_cost(j.clearance, ring, opts, mass=m, params=info["params"],
-                         load=1000.0, nstep=20000)
+    cost = exact_ln_cost(j.clearance, ring, opts, mass=m, params=info["params"], load=1000.0, nstep=20000)
     return (
         "\n".join(lines) + "\n\n"
         f"Worst over speeds and directions: peak force {worst[0] * 100:.2f} %, penetration "
@@ -186,8 +213,8 @@ def _full_cost(nstep: int = 20000) -> str:
     import copy
 
     import mujoco.rollout
-    from clearance.contact_calibration.exact_ln import ExactLNContact, step_exact_ln
 
+    from clearance.contact_calibration.exact_ln import ExactLNContact, step_exact_ln
     from clearance.options import ContactMode
 
     prep = prepare(slider_crank(), ModelOptions(contact_mode=ContactMode.CALIBRATED, timestep=TIMESTEP))
@@ -200,8 +227,13 @@ def _full_cost(nstep: int = 20000) -> str:
     roll = nstep / (time.perf_counter() - t0)
     ex_model = copy.copy(model)
     j = prep.mechanism.clearance_joints[0]
-    contact = ExactLNContact(ex_model, j.clearance, prep.built.rings[j.name],
-                             journal_geom=f"{j.name}__journal", bearing_site=f"{j.name}__bearing")
+    contact = ExactLNContact(
+        ex_model,
+        j.clearance,
+        prep.built.rings[j.name],
+        journal_geom=f"{j.name}__journal",
+        bearing_site=f"{j.name}__bearing",
+    )
     d2 = mujoco.MjData(ex_model)
     mujoco.mj_resetDataKeyframe(ex_model, d2, 0)
     t0 = time.perf_counter()
@@ -218,8 +250,12 @@ def _full_cost(nstep: int = 20000) -> str:
 
 def main(argv: list[str] | None = None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--timestep-us", type=float, default=ModelOptions().timestep * 1e6,
-                    help="MuJoCo time step [µs] (default: the package default)")
+    ap.add_argument(
+        "--timestep-us",
+        type=float,
+        default=ModelOptions().timestep * 1e6,
+        help="MuJoCo time step [µs] (default: the package default)",
+    )
     ap.add_argument("--out", default=str(Path(__file__).with_suffix(".md")))
     args = ap.parse_args(argv)
     global TIMESTEP
@@ -228,12 +264,15 @@ def main(argv: list[str] | None = None) -> int:
     with tempfile.TemporaryDirectory() as tmp:
         os.environ["CLEARANCE_CACHE_DIR"] = tmp
         mech = slider_crank()
-        a, info = _case("A. Default joint, default fit range, cycle-median effective mass (as `prepare` sizes it)",
-                        mech, cycle=True)
-        c, _ = _case("B. Default joint, fitted over one decade (0.3–3 m/s)", mech, cycle=True,
-                     speeds=np.geomspace(0.3, 3.0, 6))
-        d, _ = _case("C. c = 0.1 mm, default fit range", slider_crank(radial_clearance=0.1e-3), cycle=True,
-                     eval_speeds=None)
+        a, info = _case(
+            "A. Default joint, default fit range, cycle-median effective mass (as `prepare` sizes it)", mech, cycle=True
+        )
+        c, _ = _case(
+            "B. Default joint, fitted over one decade (0.3–3 m/s)", mech, cycle=True, speeds=np.geomspace(0.3, 3.0, 6)
+        )
+        d, _ = _case(
+            "C. c = 0.1 mm, default fit range", slider_crank(radial_clearance=0.1e-3), cycle=True, eval_speeds=None
+        )
         ex = _exact(info) + "\n" + _full_cost()
         fit_range = _fit_range_check()
     text = (
@@ -248,7 +287,11 @@ def main(argv: list[str] | None = None) -> int:
         "duration within 10 %, restitution within 0.02 of the LN impact's own (0.9132 at cₑ = 0.9). "
         "Cells: mean over the two impact directions (at a segment, between two), worst direction "
         "in brackets; bold = outside the goal.\n\n"
-        + a + "\n" + c + "\n" + d
+        + a
+        + "\n"
+        + c
+        + "\n"
+        + d
         + "\n## Fit range against the impacts of a run\n\n"
         "The fit range's top speed is the speed a journal gains crossing its clearance under the "
         "ideal joint's peak load, sqrt(2 F_peak c / m_eff) (`JointSizing.impact_speed`), known before "
@@ -256,11 +299,14 @@ def main(argv: list[str] | None = None) -> int:
         "start-up impact is the fastest, and crosses the clearance under about that load) the "
         "ratio in the last column says how far the fitted range reaches; impacts beyond its top are "
         "extrapolated, which costs peak-force accuracy (tables above: the error grows towards the "
-        "range's ends):\n\n" + fit_range
-        + "\n## Why calibrated mode misses at the ends of the range\n\n" + WHY
+        "range's ends):\n\n"
+        + fit_range
+        + "\n## Why calibrated mode misses at the ends of the range\n\n"
+        + WHY
         + "\n## Exact-LN mode (case A's joint and mass)\n\n"
         "LN imposed on the ring rows each step (Python step loop); worst of three directions "
-        "(at a segment, between two, 0.3 pitch). Goal: 1 % on all four.\n\n" + ex
+        "(at a segment, between two, 0.3 pitch). Goal: 1 % on all four.\n\n"
+        + ex
         + "\nTimings come from a shared machine and varied between runs (exact-LN 7.5k–21k "
         "steps/s in contact, rollout 100k–216k); compare the ratios, each taken within one run.\n"
     )

@@ -18,10 +18,11 @@ import os
 import platform
 import sys
 import time
-from datetime import datetime, timezone
+from datetime import UTC, datetime
 
 import numpy as np
 import scipy
+
 from clearance.builders import rpm, slider_crank
 from clearance.reference import run_reference
 
@@ -53,17 +54,30 @@ def _header(*cols: str) -> list[str]:
 
 
 def speed_table(revs: float) -> list[str]:
-    rows = _header("scenario", "revolutions", "wall [s]", "wall / rev [s]", "CPU / rev [s]",
-                   "RHS evals / rev", "steps / rev", "impacts / rev", "peak force [N]")
+    rows = _header(
+        "scenario",
+        "revolutions",
+        "wall [s]",
+        "wall / rev [s]",
+        "CPU / rev [s]",
+        "RHS evals / rev",
+        "steps / rev",
+        "impacts / rev",
+        "peak force [N]",
+    )
     slow = slider_crank(crank_speed=rpm(200), gravity=9.81)
-    for label, mech, n in (("default: 5000 rpm, no gravity", slider_crank(), revs),
-                           ("200 rpm, gravity 9.81", slow, max(revs / 3, 1))):
+    for label, mech, n in (
+        ("default: 5000 rpm, no gravity", slider_crank(), revs),
+        ("200 rpm, gravity 9.81", slow, max(revs / 3, 1)),
+    ):
         res, wall, cpu = _run(mech, n * _period(mech), repeat=3)
         md = res.metadata
-        rows.append(f"| {label} | {n:g} | {wall:.2f} | {wall / n:.2f} | {cpu / n:.2f} | "
-                    f"{md['n_rhs'] / n:.0f} | "
-                    f"{md['n_steps'] / n:.0f} | {md['impacts']['rod_slider'] / n:.1f} | "
-                    f"{res.joints['rod_slider'].force_magnitude.max():.4g} |")
+        rows.append(
+            f"| {label} | {n:g} | {wall:.2f} | {wall / n:.2f} | {cpu / n:.2f} | "
+            f"{md['n_rhs'] / n:.0f} | "
+            f"{md['n_steps'] / n:.0f} | {md['impacts']['rod_slider'] / n:.1f} | "
+            f"{res.joints['rod_slider'].force_magnitude.max():.4g} |"
+        )
     return rows
 
 
@@ -74,9 +88,18 @@ def method_table() -> list[str]:
     ref, _, _ = _run(mech, horizon, rtol=1e-12, method="DOP853", output_interval=1e-6)
     f_ref = ref.joints["rod_slider"].force_magnitude
     on_ref = np.array(ref.metadata["contact_onsets"]["rod_slider"])
-    rows = _header("method", "rtol", "wall / rev [s]", "CPU / rev [s]", "RHS evals / rev",
-                   "steps / rev", "onset time error [s]", "approach speed error",
-                   "force error, first impact", "force error, 1.5 ms")
+    rows = _header(
+        "method",
+        "rtol",
+        "wall / rev [s]",
+        "CPU / rev [s]",
+        "RHS evals / rev",
+        "steps / rev",
+        "onset time error [s]",
+        "approach speed error",
+        "force error, first impact",
+        "force error, 1.5 ms",
+    )
     first = int(0.5e-3 / 1e-6)
     for method in ("LSODA", "DOP853", "RK45", "Radau", "BDF"):
         for rtol in (1e-9, 1e-10):
@@ -88,39 +111,52 @@ def method_table() -> list[str]:
             dv_on = np.max(np.abs(on[:n, 1] - on_ref[:n, 1]) / on_ref[:n, 1])
             full, wall, cpu = _run(mech, period, repeat=3, rtol=rtol, method=method)
             md = full.metadata
-            rows.append(f"| {method} | {rtol:g} | {wall:.2f} | {cpu:.2f} | {md['n_rhs']:.0f} | "
-                        f"{md['n_steps']:.0f} | {dt_on:.1e} | {dv_on:.1e} | "
-                        f"{err[:first].max():.1e} | {err.max():.1e} |")
+            rows.append(
+                f"| {method} | {rtol:g} | {wall:.2f} | {cpu:.2f} | {md['n_rhs']:.0f} | "
+                f"{md['n_steps']:.0f} | {dt_on:.1e} | {dv_on:.1e} | "
+                f"{err[:first].max():.1e} | {err.max():.1e} |"
+            )
     return rows
 
 
 def stabilisation_table(revs: float) -> list[str]:
-    rows = _header("scenario", "stabilisation", "max closure violation [m]",
-                   "energy residual (c_e = 1)", "projections", "CPU / rev [s]")
-    for label, speed, g, n in (("5000 rpm", 5000, 0.0, revs),
-                               ("200 rpm, gravity", 200, 9.81, max(revs / 3, 1))):
+    rows = _header(
+        "scenario",
+        "stabilisation",
+        "max closure violation [m]",
+        "energy residual (c_e = 1)",
+        "projections",
+        "CPU / rev [s]",
+    )
+    for label, speed, g, n in (("5000 rpm", 5000, 0.0, revs), ("200 rpm, gravity", 200, 9.81, max(revs / 3, 1))):
         mech = slider_crank(crank_speed=rpm(speed), gravity=g, restitution=1.0)
         for stab in ("baumgarte", "projection", "none"):
             res, _, cpu = _run(mech, n * _period(mech), stabilisation=stab, track_work=True)
-            rows.append(f"| {label}, {n:g} rev | {stab} | {res.closure_violation.max():.2e} | "
-                        f"{_energy_residual(res):.1e} | {res.metadata['n_projections']} | {cpu / n:.2f} |")
+            rows.append(
+                f"| {label}, {n:g} rev | {stab} | {res.closure_violation.max():.2e} | "
+                f"{_energy_residual(res):.1e} | {res.metadata['n_projections']} | {cpu / n:.2f} |"
+            )
     return rows
 
 
 def drift_table() -> list[str]:
-    rows = _header("run", "method", "stabilisation", "closure, first 10 % [m]",
-                   "closure, last 10 % [m]", "projections", "CPU [s]")
+    rows = _header(
+        "run", "method", "stabilisation", "closure, first 10 % [m]", "closure, last 10 % [m]", "projections", "CPU [s]"
+    )
     period = 2 * math.pi / rpm(5000)
-    for label, mech, revs in (("ideal slider-crank, 100 rev", slider_crank(clearance_at=()), 100),
-                              ("default scenario, 10 rev", slider_crank(), 10)):
+    for label, mech, revs in (
+        ("ideal slider-crank, 100 rev", slider_crank(clearance_at=()), 100),
+        ("default scenario, 10 rev", slider_crank(), 10),
+    ):
         for method in ("LSODA", "DOP853"):
             for stab in ("none", "baumgarte", "projection"):
-                res, _, cpu = _run(mech, revs * period, method=method, stabilisation=stab,
-                                   output_interval=1e-4)
+                res, _, cpu = _run(mech, revs * period, method=method, stabilisation=stab, output_interval=1e-4)
                 cv = res.closure_violation
                 k = len(cv) // 10
-                rows.append(f"| {label} | {method} | {stab} | {cv[:k].max():.1e} | {cv[-k:].max():.1e} | "
-                            f"{res.metadata['n_projections']} | {cpu:.2f} |")
+                rows.append(
+                    f"| {label} | {method} | {stab} | {cv[:k].max():.1e} | {cv[-k:].max():.1e} | "
+                    f"{res.metadata['n_projections']} | {cpu:.2f} |"
+                )
     return rows
 
 
@@ -150,7 +186,7 @@ def main(argv: list[str] | None = None) -> None:
         "",
         f"Machine: {platform.processor() or platform.machine()}, {os.cpu_count()} cores; Python "
         f"{platform.python_version()}, NumPy {np.__version__}, SciPy {scipy.__version__}; "
-        f"{datetime.now(timezone.utc):%Y-%m-%d %H:%M} UTC. Measured on a "
+        f"{datetime.now(UTC):%Y-%m-%d %H:%M} UTC. Measured on a "
         "shared machine with other work running: expect +-30 % scatter in wall times.",
         "",
         "Defaults: LSODA, rtol 1e-9, coordinate projection, output every 1e-5 s. Wall and CPU",

@@ -20,13 +20,13 @@ import time
 from pathlib import Path
 
 import rerun as rr
+
 from clearance.analysis.recording.rerun_log import (
     DEFAULT_MAX_RATE_HZ,
     LoggedRun,
     record_runs,
 )
 from clearance.builders import slider_crank
-
 from clearance.run.simulation import default_duration, simulate
 
 
@@ -64,15 +64,29 @@ def main() -> None:
     dec = res1.decimated(10)
     cases = [
         ("rod_slider, no ideal", [LoggedRun(res1, mech1)], DEFAULT_MAX_RATE_HZ, t_sim1, len(res1)),
-        ("rod_slider + ideal twin (as `clearance run --rerun`)", [LoggedRun(res1, mech1, ideal=ideal)],
-         DEFAULT_MAX_RATE_HZ, t_sim1 + t_ideal, len(res1)),
+        (
+            "rod_slider + ideal twin (as `clearance run --rerun`)",
+            [LoggedRun(res1, mech1, ideal=ideal)],
+            DEFAULT_MAX_RATE_HZ,
+            t_sim1 + t_ideal,
+            len(res1),
+        ),
         ("rod_slider, mechanism at every step (max_rate_hz=None)", [LoggedRun(res1, mech1)], None, t_sim1, len(res1)),
         ("crank_rod + rod_slider", [LoggedRun(res2, mech2)], DEFAULT_MAX_RATE_HZ, t_sim2, len(res2)),
-        (f"rod_slider, every 10th step stored ({10 * res1.metadata['time_step'] * 1e6:g} µs, result.decimated(10))", [LoggedRun(dec, mech1)], DEFAULT_MAX_RATE_HZ,
-         t_sim1, len(dec)),
-        ("two runs under mujoco/ and reference/ prefixes (same arrays twice)",
-         [LoggedRun(res1, mech1, prefix="mujoco"), LoggedRun(res1, mech1, prefix="reference")],
-         DEFAULT_MAX_RATE_HZ, t_sim1, 2 * len(res1)),
+        (
+            f"rod_slider, every 10th step stored ({10 * res1.metadata['time_step'] * 1e6:g} µs, result.decimated(10))",
+            [LoggedRun(dec, mech1)],
+            DEFAULT_MAX_RATE_HZ,
+            t_sim1,
+            len(dec),
+        ),
+        (
+            "two runs under mujoco/ and reference/ prefixes (same arrays twice)",
+            [LoggedRun(res1, mech1, prefix="mujoco"), LoggedRun(res1, mech1, prefix="reference")],
+            DEFAULT_MAX_RATE_HZ,
+            t_sim1,
+            2 * len(res1),
+        ),
     ]
     rows = []
     with tempfile.TemporaryDirectory() as tmp:

@@ -24,10 +24,10 @@ import time
 from _tables import (
     write_keeping_reading,  # benchmarks/_tables.py (scripts run from benchmarks/)
 )
-from clearance.builders import slider_crank
-from clearance.mjcf.probe import measured_ripple, ring_scene
 
 from clearance import ModelOptions
+from clearance.builders import slider_crank
+from clearance.mjcf.probe import measured_ripple, ring_scene
 from clearance.run.preparation import prepare
 from clearance.run.simulation import simulate_prepared
 
@@ -47,8 +47,14 @@ def measure(journal: str, segment: str, n: int | None, base: ModelOptions) -> di
     scene = ring_scene(ring, opts, prep.contact["rod_slider"])
     d = prep.sizing["rod_slider"].typical_penetration
     rip = [measured_ripple(scene, ring, f * d) for f in (0.5, 1.0, 2.0)]
-    return {"pair": f"{journal}/{segment}", "N": ring.segments, "steps_per_s": best, "ripple": rip, "delta_um": d * 1e6,
-            "peak_kN": r.joints["rod_slider"].force_magnitude.max() / 1e3}
+    return {
+        "pair": f"{journal}/{segment}",
+        "N": ring.segments,
+        "steps_per_s": best,
+        "ripple": rip,
+        "delta_um": d * 1e6,
+        "peak_kN": r.joints["rod_slider"].force_magnitude.max() / 1e3,
+    }
 
 
 def main() -> None:

@@ -28,7 +28,9 @@ HERE = Path(__file__).resolve().parent
 
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    ap.add_argument("--out", default="build/bench", help="bench folder (default build/bench, run from the repository root)")
+    ap.add_argument(
+        "--out", default="build/bench", help="bench folder (default build/bench, run from the repository root)"
+    )
     ap.add_argument("--stage", choices=("all", "accuracy", "timing", "report"), default="all")
     ap.add_argument("--workers", type=int, default=None)
     args = ap.parse_args()

@@ -16,10 +16,9 @@ from __future__ import annotations
 import argparse
 import time
 
+from clearance import ContactLaw, ModelOptions, simulate
 from clearance.builders import rpm, slider_crank
 from clearance.reference import run_reference
-
-from clearance import ContactLaw, ModelOptions, simulate
 from clearance.results import atomic_write_text
 
 T = 0.6e-3

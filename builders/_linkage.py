@@ -17,6 +17,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+from clearance import checks
 from clearance.kinematics import TransmissionAngle, assemble
 from clearance.model import (
     Clearance,
@@ -78,10 +79,8 @@ class LinkageInfo:
 
 
 def positive(name: str, value: float, unit: str = "m") -> float:
-    """Check that a builder argument is a finite number > 0; return it as float."""
-    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value) or value <= 0:
-        raise ValueError(f"{name} must be a finite number > 0 (got {value!r} {unit})")
-    return float(value)
+    """Check that a builder argument is a finite number > 0 (metres unless ``unit``); return it as float."""
+    return checks.positive(name, value, unit)
 
 
 def polar(origin: Point, length: float, angle: float) -> Point:
@@ -126,7 +125,9 @@ def line_circle(p0: Point, direction: Point, centre: Point, r: float, *, forward
     return (p0[0] + s * ux, p0[1] + s * uy)
 
 
-def _mass_properties(local: Mapping[str, Point], bars: Sequence[tuple[str, str]], density: float) -> tuple[float, float, Point]:
+def _mass_properties(
+    local: Mapping[str, Point], bars: Sequence[tuple[str, str]], density: float
+) -> tuple[float, float, Point]:
     """(mass [kg], inertia about the com [kg m^2], com [m]) of slender bars."""
     parts = []
     for a, b in bars:
@@ -291,14 +292,20 @@ def advance(mechanism: Mechanism, start_angle: float) -> Mechanism:
         return mechanism
     probe = dataclasses.replace(
         mechanism,
-        drives=(dataclasses.replace(drive, kind=DriveKind.CONSTANT_SPEED, speed=math.copysign(1.0, start_angle),
-                                    start_angle=0.0),),
+        drives=(
+            dataclasses.replace(
+                drive, kind=DriveKind.CONSTANT_SPEED, speed=math.copysign(1.0, start_angle), start_angle=0.0
+            ),
+        ),
     )
     q = solve_kinematics(probe, [0.0, abs(start_angle)]).q[-1]
     names = [m.name for m in mechanism.moving_links]
     links = tuple(
-        lk if lk.name == mechanism.ground
-        else dataclasses.replace(lk, pose_guess=tuple(float(v) for v in q[3 * names.index(lk.name) : 3 * names.index(lk.name) + 3]))
+        lk
+        if lk.name == mechanism.ground
+        else dataclasses.replace(
+            lk, pose_guess=tuple(float(v) for v in q[3 * names.index(lk.name) : 3 * names.index(lk.name) + 3])
+        )
         for lk in mechanism.links
     )
     return dataclasses.replace(mechanism, links=links, drives=(dataclasses.replace(drive, start_angle=start_angle),))

@@ -15,7 +15,6 @@ import math
 from typing import Any
 
 from clearance.builders._toml_reader import Table
-
 from clearance.kinematics import AssemblyError
 from clearance.model import ContactLaw, Material, Mechanism, MotionLaw
 from clearance.units import UNITS, describe_units, quantity_of
@@ -36,7 +35,7 @@ def _match(key: str, params: list[str]) -> tuple[str, float] | None:
         if q is None:
             return key, 1.0
         raise ValueError(f"needs a unit in its name ({describe_units(key, q)})")
-    candidates = [key] + [t + key[len(a):] for a, t in _ALIASES.items() if key.startswith(a + "_") and t in params]
+    candidates = [key] + [t + key[len(a) :] for a, t in _ALIASES.items() if key.startswith(a + "_") and t in params]
     bad = None
     for k in candidates:
         for p in sorted(params, key=len, reverse=True):
@@ -75,8 +74,10 @@ def _convert(t: Table, key: str, param: str, factor: float, value: Any) -> Any:
             raise t.error(key, f"must be one of {[law.value for law in ContactLaw]} (got {value!r})") from None
     if param == "material":
         sub = Table(value, t.loc + (key,), f"{t.label} [{key}]", t.locator)
-        m = Material(sub.number("youngs_modulus", "pressure", Material().youngs_modulus),
-                     sub.plain("poisson_ratio", Material().poisson_ratio))
+        m = Material(
+            sub.number("youngs_modulus", "pressure", Material().youngs_modulus),
+            sub.plain("poisson_ratio", Material().poisson_ratio),
+        )
         sub.finish(["youngs_modulus_<pa|mpa|gpa>", "poisson_ratio"])
         return m
     if param.endswith("_motion"):

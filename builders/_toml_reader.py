@@ -148,7 +148,7 @@ class Table:
         bad = [k for k in found if k not in good]
         if bad:
             self.used.update(bad)
-            raise self.error(bad[0], f"bad unit '{bad[0][len(base) + 1:]}' ({describe_units(base, quantity)})")
+            raise self.error(bad[0], f"bad unit '{bad[0][len(base) + 1 :]}' ({describe_units(base, quantity)})")
         if len(good) > 1:
             raise self.error(good[1], f"{base} is given twice ({', '.join(good)})")
         if not good:
@@ -190,8 +190,9 @@ class Table:
                 raise self.error(None, f"missing table '{key}'")
             return None
         self.used.add(key)
-        return Table(self.data[key], self.loc + (key,), f"{self.label} [{key}]" if self.label else f"[{key}]",
-                     self.locator)
+        return Table(
+            self.data[key], self.loc + (key,), f"{self.label} [{key}]" if self.label else f"[{key}]", self.locator
+        )
 
     def array(self, key: str) -> list[Table]:
         """The array of tables ``[[key]]`` (empty when absent)."""

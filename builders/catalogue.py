@@ -17,6 +17,7 @@ from types import MappingProxyType
 from typing import Any
 
 import numpy as np
+
 from clearance.builders._linkage import LinkageInfo
 from clearance.builders.four_bar import FOUR_BAR_INFO, four_bar
 from clearance.builders.multiloop import (
@@ -45,17 +46,27 @@ from clearance.builders.watt import (
     watt_six_bar_slider_1,
     watt_six_bar_slider_2,
 )
-
 from clearance.kinematics import TransmissionAngle, solve_kinematics, transmission_angle
 from clearance.model import DriveKind, Mechanism
 
-__all__ = ["CatalogueEntry", "CATALOGUE", "CRANK_SPEED_RANGE", "PRESS_SPEED_RANGE", "SLIDER_CRANK_INFO", "names",
-           "get", "build", "LinkageCheck", "check_linkage"]
+__all__ = [
+    "CatalogueEntry",
+    "CATALOGUE",
+    "CRANK_SPEED_RANGE",
+    "PRESS_SPEED_RANGE",
+    "SLIDER_CRANK_INFO",
+    "names",
+    "get",
+    "build",
+    "LinkageCheck",
+    "check_linkage",
+]
 
 SLIDER_CRANK_INFO = LinkageInfo(
-    topology="In-line slider-crank: ground (crank_pivot, guide), crank (driven), rod, slider "
-    "(output: its x position).",
-    driven=("crank_pivot",), output_pivot="slider_guide", clearable=("crank_rod", "rod_slider"),
+    topology="In-line slider-crank: ground (crank_pivot, guide), crank (driven), rod, slider (output: its x position).",
+    driven=("crank_pivot",),
+    output_pivot="slider_guide",
+    clearable=("crank_rod", "rod_slider"),
     criticality=("crank_rod", "rod_slider"),
     transmission=(TransmissionAngle("rod_slider", ("rod", "big_end"), guide="slider_guide"),),
     provenance="Flores and Ambrosio benchmark, REFERENCES.md section 3 (crank and rod checked, "
@@ -96,27 +107,38 @@ class CatalogueEntry:
     def __post_init__(self) -> None:
         lo, hi = self.speed_range
         if not (0 < lo <= hi < math.inf):
-            raise ValueError(f"catalogue entry '{self.name}' speed_range must satisfy 0 < low <= high "
-                             f"(got {self.speed_range!r} rad/s)")
+            raise ValueError(
+                f"catalogue entry '{self.name}' speed_range must satisfy 0 < low <= high "
+                f"(got {self.speed_range!r} rad/s)"
+            )
 
 
-CATALOGUE: Mapping[str, CatalogueEntry] = MappingProxyType({
-    e.name: e for e in (
-        CatalogueEntry("slider_crank", slider_crank, "slider-crank", SLIDER_CRANK_INFO),
-        CatalogueEntry("four_bar", four_bar, "four-bar", FOUR_BAR_INFO),
-        CatalogueEntry("watt_six_bar", watt_six_bar, "Watt six-bar", WATT_INFO),
-        CatalogueEntry("watt_six_bar_slider_1", watt_six_bar_slider_1, "Watt six-bar", WATT_SLIDER_1_INFO),
-        CatalogueEntry("watt_six_bar_slider_2", watt_six_bar_slider_2, "Watt six-bar", WATT_SLIDER_2_INFO),
-        CatalogueEntry("stephenson_i", stephenson_i, "Stephenson six-bar", STEPHENSON_I_INFO),
-        CatalogueEntry("stephenson_i_slider", stephenson_i_slider, "Stephenson six-bar", STEPHENSON_I_SLIDER_INFO),
-        CatalogueEntry("stephenson_ii_1", stephenson_ii_1, "Stephenson six-bar", STEPHENSON_II_1_INFO),
-        CatalogueEntry("stephenson_ii_2", stephenson_ii_2, "Stephenson six-bar", STEPHENSON_II_2_INFO),
-        CatalogueEntry("eight_bar", eight_bar, "multi-loop", EIGHT_BAR_INFO),
-        CatalogueEntry("ten_bar", ten_bar, "multi-loop", TEN_BAR_INFO),
-        CatalogueEntry("seven_bar_press", seven_bar_press, "press", PRESS_INFO, speed_keyword="crank2_speed",
-                       speed_range=PRESS_SPEED_RANGE),
-    )
-})
+CATALOGUE: Mapping[str, CatalogueEntry] = MappingProxyType(
+    {
+        e.name: e
+        for e in (
+            CatalogueEntry("slider_crank", slider_crank, "slider-crank", SLIDER_CRANK_INFO),
+            CatalogueEntry("four_bar", four_bar, "four-bar", FOUR_BAR_INFO),
+            CatalogueEntry("watt_six_bar", watt_six_bar, "Watt six-bar", WATT_INFO),
+            CatalogueEntry("watt_six_bar_slider_1", watt_six_bar_slider_1, "Watt six-bar", WATT_SLIDER_1_INFO),
+            CatalogueEntry("watt_six_bar_slider_2", watt_six_bar_slider_2, "Watt six-bar", WATT_SLIDER_2_INFO),
+            CatalogueEntry("stephenson_i", stephenson_i, "Stephenson six-bar", STEPHENSON_I_INFO),
+            CatalogueEntry("stephenson_i_slider", stephenson_i_slider, "Stephenson six-bar", STEPHENSON_I_SLIDER_INFO),
+            CatalogueEntry("stephenson_ii_1", stephenson_ii_1, "Stephenson six-bar", STEPHENSON_II_1_INFO),
+            CatalogueEntry("stephenson_ii_2", stephenson_ii_2, "Stephenson six-bar", STEPHENSON_II_2_INFO),
+            CatalogueEntry("eight_bar", eight_bar, "multi-loop", EIGHT_BAR_INFO),
+            CatalogueEntry("ten_bar", ten_bar, "multi-loop", TEN_BAR_INFO),
+            CatalogueEntry(
+                "seven_bar_press",
+                seven_bar_press,
+                "press",
+                PRESS_INFO,
+                speed_keyword="crank2_speed",
+                speed_range=PRESS_SPEED_RANGE,
+            ),
+        )
+    }
+)
 """Every catalogue mechanism by name, in catalogue order."""
 
 

@@ -26,7 +26,6 @@ from clearance.builders._linkage import (
     positive,
 )
 from clearance.builders.slider_crank import rpm
-
 from clearance.kinematics import TransmissionAngle
 from clearance.model import (
     STEEL,
@@ -107,8 +106,13 @@ def four_bar(
     d = positive("ground_length", ground_length)
     lam = positive("linear_density", linear_density, "kg/m")
     clr = ClearanceFactory(
-        clearance_at, FOUR_BAR_INFO.clearable, radial_clearance=radial_clearance,
-        bearing_radius=bearing_radius, restitution=restitution, friction=friction, law=law,
+        clearance_at,
+        FOUR_BAR_INFO.clearable,
+        radial_clearance=radial_clearance,
+        bearing_radius=bearing_radius,
+        restitution=restitution,
+        friction=friction,
+        law=law,
         material=material,
     )
     o2, o4 = (0.0, 0.0), (d, 0.0)

@@ -39,7 +39,6 @@ from clearance.builders._linkage import (
     slider_link,
 )
 from clearance.builders.slider_crank import rpm
-
 from clearance.kinematics import TransmissionAngle as _T
 from clearance.model import (
     STEEL,
@@ -63,28 +62,38 @@ EIGHT_BAR_INFO = LinkageInfo(
     topology="Eight-bar: ground 1 (O2, O4, O6, guide P8), crank 2 (O2-A, driven), ternary coupler 3 "
     "(A, B, C), rocker 4 (O4-B), link 5 (C-D), ternary rocker 6 (O6, D, E), rod 7 (E-F), "
     "slider 8 (F, horizontal guide; output: its x).",
-    driven=("O2",), output_pivot="P8", clearable=("A", "B", "O4", "C", "D", "O6", "E", "F"),
+    driven=("O2",),
+    output_pivot="P8",
+    clearable=("A", "B", "O4", "C", "D", "O6", "E", "F"),
     criticality=("A", "B", "O4", "C", "D", "O6", "E", "F"),
-    transmission=(_T("B", ("coupler3", "A"), follower=("rocker4", "O4")),
-                  _T("D", ("link5", "C"), follower=("rocker6", "O6")), _T("F", ("rod7", "E"), guide="P8")),
+    transmission=(
+        _T("B", ("coupler3", "A"), follower=("rocker4", "O4")),
+        _T("D", ("link5", "C"), follower=("rocker6", "O6")),
+        _T("F", ("rod7", "E"), guide="P8"),
+    ),
     provenance=_OWN,
 )
 TEN_BAR_INFO = LinkageInfo(
     topology="Ten-bar: ground 1 (O2, O4, O6, guide P10), crank 2 (O2-A, driven), ternary coupler 3 "
     "(A, B, C), ternary rocker 4 (O4, B, D), link 5 (C-E), ternary rocker 6 (O6, E, F), link 7 "
     "(D-G), ternary link 8 (F, G, H), rod 9 (H-I), slider 10 (I, horizontal guide; output: its x).",
-    driven=("O2",), output_pivot="P10",
+    driven=("O2",),
+    output_pivot="P10",
     clearable=("A", "B", "O4", "C", "E", "O6", "D", "G", "F", "H", "I"),
     criticality=("A", "B", "O4", "C", "E", "O6", "D", "G", "F", "H", "I"),
-    transmission=(_T("B", ("coupler3", "A"), follower=("rocker4", "O4")),
-                  _T("E", ("link5", "C"), follower=("rocker6", "O6")),
-                  _T("G", ("link7", "D"), follower=("link8", "F")), _T("I", ("rod9", "H"), guide="P10")),
+    transmission=(
+        _T("B", ("coupler3", "A"), follower=("rocker4", "O4")),
+        _T("E", ("link5", "C"), follower=("rocker6", "O6")),
+        _T("G", ("link7", "D"), follower=("link8", "F")),
+        _T("I", ("rod9", "H"), guide="P10"),
+    ),
     provenance=_OWN,
 )
 
 
-def _four_bar(crank: float, coupler: float, rocker: float, ground: float, point: tuple[float, float],
-              th: float) -> dict[str, tuple[float, float]]:
+def _four_bar(
+    crank: float, coupler: float, rocker: float, ground: float, point: tuple[float, float], th: float
+) -> dict[str, tuple[float, float]]:
     o2, o4 = (0.0, 0.0), (ground, 0.0)
     pa = polar(o2, crank, th)
     pb = circle_circle(pa, coupler, o4, rocker, left=True, what="coupler 3 / rocker 4")
@@ -99,14 +108,33 @@ def _angle(p: tuple[float, float], q: tuple[float, float]) -> float:
 
 
 def eight_bar(
-    *, crank_length: float = 0.04, coupler3_length: float = 0.13, rocker4_length: float = 0.10,
-    ground_length: float = 0.13, coupler3_point: tuple[float, float] = (0.16, 0.0), link5_length: float = 0.16,
-    rocker6_length: float = 0.10, rocker6_pivot: tuple[float, float] = (0.21, -0.05), rocker6_arm: float = 0.08,
-    rocker6_arm_angle: float = math.radians(-142.0), rod7_length: float = 0.12, guide_height: float = -0.13,
-    slider_mass: float = 0.2, slider_inertia: float = 3.3e-5, linear_density: float = _LAM,
-    crank_speed: float = rpm(1000.0), start_angle: float = 0.0, clearance_at: Sequence[str] = ("D",),
-    radial_clearance: float = _C, bearing_radius: float = 0.010, restitution: float = 0.9, friction: float = 0.0,
-    law: ContactLaw = _LN, material: Material = STEEL, gravity: float = 0.0, name: str = "eight_bar",
+    *,
+    crank_length: float = 0.04,
+    coupler3_length: float = 0.13,
+    rocker4_length: float = 0.10,
+    ground_length: float = 0.13,
+    coupler3_point: tuple[float, float] = (0.16, 0.0),
+    link5_length: float = 0.16,
+    rocker6_length: float = 0.10,
+    rocker6_pivot: tuple[float, float] = (0.21, -0.05),
+    rocker6_arm: float = 0.08,
+    rocker6_arm_angle: float = math.radians(-142.0),
+    rod7_length: float = 0.12,
+    guide_height: float = -0.13,
+    slider_mass: float = 0.2,
+    slider_inertia: float = 3.3e-5,
+    linear_density: float = _LAM,
+    crank_speed: float = rpm(1000.0),
+    start_angle: float = 0.0,
+    clearance_at: Sequence[str] = ("D",),
+    radial_clearance: float = _C,
+    bearing_radius: float = 0.010,
+    restitution: float = 0.9,
+    friction: float = 0.0,
+    law: ContactLaw = _LN,
+    material: Material = STEEL,
+    gravity: float = 0.0,
+    name: str = "eight_bar",
 ) -> Mechanism:
     """Build the eight-bar: Stephenson II (1) plus rod 7 and an output slider.
 
@@ -133,14 +161,31 @@ def eight_bar(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {k: positive(k, v) for k, v in (("crank_length", crank_length), ("coupler3_length", coupler3_length),
-            ("rocker4_length", rocker4_length), ("ground_length", ground_length), ("link5_length", link5_length),
-            ("rocker6_length", rocker6_length), ("rocker6_arm", rocker6_arm), ("rod7_length", rod7_length))}
+    dims = {
+        k: positive(k, v)
+        for k, v in (
+            ("crank_length", crank_length),
+            ("coupler3_length", coupler3_length),
+            ("rocker4_length", rocker4_length),
+            ("ground_length", ground_length),
+            ("link5_length", link5_length),
+            ("rocker6_length", rocker6_length),
+            ("rocker6_arm", rocker6_arm),
+            ("rod7_length", rod7_length),
+        )
+    }
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(clearance_at, EIGHT_BAR_INFO.clearable, radial_clearance=radial_clearance,
-                           bearing_radius=bearing_radius, restitution=restitution, friction=friction, law=law,
-                           material=material)
+    clr = ClearanceFactory(
+        clearance_at,
+        EIGHT_BAR_INFO.clearable,
+        radial_clearance=radial_clearance,
+        bearing_radius=bearing_radius,
+        restitution=restitution,
+        friction=friction,
+        law=law,
+        material=material,
+    )
     cp = (float(coupler3_point[0]), float(coupler3_point[1]))
     p = _four_bar(crank_length, coupler3_length, rocker4_length, ground_length, cp, start_angle)
     o6 = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
@@ -151,8 +196,12 @@ def eight_bar(
     links = (
         Link("ground", 0.0, 0.0, points={"O2": p["O2"], "O4": p["O4"], "O6": o6, "G8": g8}),
         bar_link("crank2", {"O2": p["O2"], "A": p["A"]}, density=lam),
-        bar_link("coupler3", {"A": p["A"], "B": p["B"], "C": p["C"]}, density=lam,
-                 bars=[("A", "C")] if cp[1] == 0 and cp[0] >= 0 else None),
+        bar_link(
+            "coupler3",
+            {"A": p["A"], "B": p["B"], "C": p["C"]},
+            density=lam,
+            bars=[("A", "C")] if cp[1] == 0 and cp[0] >= 0 else None,
+        ),
         bar_link("rocker4", {"O4": p["O4"], "B": p["B"]}, density=lam),
         bar_link("link5", {"C": p["C"], "D": pd}, density=lam),
         bar_link("rocker6", {"O6": o6, "D": pd, "E": pe}, density=lam, bars=[("O6", "D"), ("O6", "E")]),
@@ -160,35 +209,76 @@ def eight_bar(
         slider_link("slider8", {"F": pf}, mass=ms, inertia=js),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"), clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"), clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("C", "coupler3", "C", "link5", "C"), clr.revolute("D", "link5", "D", "rocker6", "D"),
-        clr.revolute("O6", "ground", "O6", "rocker6", "O6"), clr.revolute("E", "rocker6", "E", "rod7", "E"),
+        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
+        clr.revolute("A", "crank2", "A", "coupler3", "A"),
+        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
+        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
+        clr.revolute("C", "coupler3", "C", "link5", "C"),
+        clr.revolute("D", "link5", "D", "rocker6", "D"),
+        clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
+        clr.revolute("E", "rocker6", "E", "rod7", "E"),
         clr.revolute("F", "rod7", "F", "slider8", "F"),
         Joint("P8", JointType.PRISMATIC, "ground", "G8", "slider8", "F", axis=(1.0, 0.0)),
     )
-    dims.update(coupler3_point=list(cp), rocker6_pivot=list(o6), rocker6_arm_angle=float(rocker6_arm_angle),
-                guide_height=float(guide_height), slider_mass=ms, slider_inertia=js, linear_density=lam,
-                crank_speed=float(crank_speed), start_angle=float(start_angle), **clr.parameters(),
-                gravity=float(gravity))
-    return finish(Mechanism(
-        name=name, links=links, joints=joints, drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-        outputs=(Output("slider_x", "slider8", OutputKind.POSITION_X, point="F"),), gravity=(0.0, -gravity),
-        parameters=dims,
-    ))
+    dims.update(
+        coupler3_point=list(cp),
+        rocker6_pivot=list(o6),
+        rocker6_arm_angle=float(rocker6_arm_angle),
+        guide_height=float(guide_height),
+        slider_mass=ms,
+        slider_inertia=js,
+        linear_density=lam,
+        crank_speed=float(crank_speed),
+        start_angle=float(start_angle),
+        **clr.parameters(),
+        gravity=float(gravity),
+    )
+    return finish(
+        Mechanism(
+            name=name,
+            links=links,
+            joints=joints,
+            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
+            outputs=(Output("slider_x", "slider8", OutputKind.POSITION_X, point="F"),),
+            gravity=(0.0, -gravity),
+            parameters=dims,
+        )
+    )
 
 
 def ten_bar(
-    *, crank_length: float = 0.04, coupler3_length: float = 0.13, rocker4_length: float = 0.10,
-    ground_length: float = 0.13, coupler3_point: tuple[float, float] = (0.09, -0.04), rocker4_arm: float = 0.05,
-    rocker4_arm_angle: float = math.radians(-150.0), link5_length: float = 0.12, rocker6_length: float = 0.08,
-    rocker6_pivot: tuple[float, float] = (0.14, -0.10), rocker6_arm: float = 0.07,
-    rocker6_arm_angle: float = math.radians(120.0), link7_length: float = 0.10, link8_length: float = 0.10,
-    link8_point: tuple[float, float] = (0.0, 0.08), rod9_length: float = 0.10, guide_height: float = -0.224,
-    slider_mass: float = 0.2, slider_inertia: float = 3.3e-5, linear_density: float = _LAM,
-    crank_speed: float = rpm(1000.0), start_angle: float = 0.0, clearance_at: Sequence[str] = ("G",),
-    radial_clearance: float = _C, bearing_radius: float = 0.010, restitution: float = 0.9, friction: float = 0.0,
-    law: ContactLaw = _LN, material: Material = STEEL, gravity: float = 0.0, name: str = "ten_bar",
+    *,
+    crank_length: float = 0.04,
+    coupler3_length: float = 0.13,
+    rocker4_length: float = 0.10,
+    ground_length: float = 0.13,
+    coupler3_point: tuple[float, float] = (0.09, -0.04),
+    rocker4_arm: float = 0.05,
+    rocker4_arm_angle: float = math.radians(-150.0),
+    link5_length: float = 0.12,
+    rocker6_length: float = 0.08,
+    rocker6_pivot: tuple[float, float] = (0.14, -0.10),
+    rocker6_arm: float = 0.07,
+    rocker6_arm_angle: float = math.radians(120.0),
+    link7_length: float = 0.10,
+    link8_length: float = 0.10,
+    link8_point: tuple[float, float] = (0.0, 0.08),
+    rod9_length: float = 0.10,
+    guide_height: float = -0.224,
+    slider_mass: float = 0.2,
+    slider_inertia: float = 3.3e-5,
+    linear_density: float = _LAM,
+    crank_speed: float = rpm(1000.0),
+    start_angle: float = 0.0,
+    clearance_at: Sequence[str] = ("G",),
+    radial_clearance: float = _C,
+    bearing_radius: float = 0.010,
+    restitution: float = 0.9,
+    friction: float = 0.0,
+    law: ContactLaw = _LN,
+    material: Material = STEEL,
+    gravity: float = 0.0,
+    name: str = "ten_bar",
 ) -> Mechanism:
     """Build the ten-bar: four-bar, dyad 5-6 to ground, dyad 7-8 between the rockers, slider.
 
@@ -213,15 +303,34 @@ def ten_bar(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {k: positive(k, v) for k, v in (("crank_length", crank_length), ("coupler3_length", coupler3_length),
-            ("rocker4_length", rocker4_length), ("ground_length", ground_length), ("rocker4_arm", rocker4_arm),
-            ("link5_length", link5_length), ("rocker6_length", rocker6_length), ("rocker6_arm", rocker6_arm),
-            ("link7_length", link7_length), ("link8_length", link8_length), ("rod9_length", rod9_length))}
+    dims = {
+        k: positive(k, v)
+        for k, v in (
+            ("crank_length", crank_length),
+            ("coupler3_length", coupler3_length),
+            ("rocker4_length", rocker4_length),
+            ("ground_length", ground_length),
+            ("rocker4_arm", rocker4_arm),
+            ("link5_length", link5_length),
+            ("rocker6_length", rocker6_length),
+            ("rocker6_arm", rocker6_arm),
+            ("link7_length", link7_length),
+            ("link8_length", link8_length),
+            ("rod9_length", rod9_length),
+        )
+    }
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(clearance_at, TEN_BAR_INFO.clearable, radial_clearance=radial_clearance,
-                           bearing_radius=bearing_radius, restitution=restitution, friction=friction, law=law,
-                           material=material)
+    clr = ClearanceFactory(
+        clearance_at,
+        TEN_BAR_INFO.clearable,
+        radial_clearance=radial_clearance,
+        bearing_radius=bearing_radius,
+        restitution=restitution,
+        friction=friction,
+        law=law,
+        material=material,
+    )
     cp = (float(coupler3_point[0]), float(coupler3_point[1]))
     p = _four_bar(crank_length, coupler3_length, rocker4_length, ground_length, cp, start_angle)
     o6 = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
@@ -247,20 +356,43 @@ def ten_bar(
         slider_link("slider10", {"I": pi_}, mass=ms, inertia=js),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"), clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"), clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("C", "coupler3", "C", "link5", "C"), clr.revolute("E", "link5", "E", "rocker6", "E"),
-        clr.revolute("O6", "ground", "O6", "rocker6", "O6"), clr.revolute("D", "rocker4", "D", "link7", "D"),
-        clr.revolute("G", "link7", "G", "link8", "G"), clr.revolute("F", "rocker6", "F", "link8", "F"),
-        clr.revolute("H", "link8", "H", "rod9", "H"), clr.revolute("I", "rod9", "I", "slider10", "I"),
+        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
+        clr.revolute("A", "crank2", "A", "coupler3", "A"),
+        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
+        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
+        clr.revolute("C", "coupler3", "C", "link5", "C"),
+        clr.revolute("E", "link5", "E", "rocker6", "E"),
+        clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
+        clr.revolute("D", "rocker4", "D", "link7", "D"),
+        clr.revolute("G", "link7", "G", "link8", "G"),
+        clr.revolute("F", "rocker6", "F", "link8", "F"),
+        clr.revolute("H", "link8", "H", "rod9", "H"),
+        clr.revolute("I", "rod9", "I", "slider10", "I"),
         Joint("P10", JointType.PRISMATIC, "ground", "G10", "slider10", "I", axis=(1.0, 0.0)),
     )
-    dims.update(coupler3_point=list(cp), rocker4_arm_angle=float(rocker4_arm_angle), rocker6_pivot=list(o6),
-                rocker6_arm_angle=float(rocker6_arm_angle), link8_point=[hu, hv], guide_height=float(guide_height),
-                slider_mass=ms, slider_inertia=js, linear_density=lam, crank_speed=float(crank_speed),
-                start_angle=float(start_angle), **clr.parameters(), gravity=float(gravity))
-    return finish(Mechanism(
-        name=name, links=links, joints=joints, drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-        outputs=(Output("slider_x", "slider10", OutputKind.POSITION_X, point="I"),), gravity=(0.0, -gravity),
-        parameters=dims,
-    ))
+    dims.update(
+        coupler3_point=list(cp),
+        rocker4_arm_angle=float(rocker4_arm_angle),
+        rocker6_pivot=list(o6),
+        rocker6_arm_angle=float(rocker6_arm_angle),
+        link8_point=[hu, hv],
+        guide_height=float(guide_height),
+        slider_mass=ms,
+        slider_inertia=js,
+        linear_density=lam,
+        crank_speed=float(crank_speed),
+        start_angle=float(start_angle),
+        **clr.parameters(),
+        gravity=float(gravity),
+    )
+    return finish(
+        Mechanism(
+            name=name,
+            links=links,
+            joints=joints,
+            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
+            outputs=(Output("slider_x", "slider10", OutputKind.POSITION_X, point="I"),),
+            gravity=(0.0, -gravity),
+            parameters=dims,
+        )
+    )

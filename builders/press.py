@@ -34,7 +34,6 @@ from clearance.builders._linkage import (
     positive,
     slider_link,
 )
-
 from clearance.kinematics import TransmissionAngle
 from clearance.model import (
     STEEL,
@@ -60,10 +59,14 @@ PRESS_INFO = LinkageInfo(
     topology="Hybrid seven-bar press (2 DOF): frame 1 (O2, O7, vertical guide P6), crank 2 (O2-A, "
     "constant-speed motor), rod 3 (A-B), triangle plate 4 (B, E, C), crank 7 (O7-E, servo), "
     "rod 5 (C-D), slider 6 (D; output: its y). Seed clearances: A and C.",
-    driven=("O2", "O7"), output_pivot="P6", clearable=("A", "B", "E", "C", "D"),
+    driven=("O2", "O7"),
+    output_pivot="P6",
+    clearable=("A", "B", "E", "C", "D"),
     criticality=("A", "B", "E", "C", "D"),
-    transmission=(TransmissionAngle("B", ("rod3", "A"), follower=("plate4", "E")),
-                  TransmissionAngle("D", ("rod5", "C"), guide="P6")),
+    transmission=(
+        TransmissionAngle("B", ("rod3", "A"), follower=("plate4", "E")),
+        TransmissionAngle("D", ("rod5", "C"), guide="P6"),
+    ),
     provenance="topology from seed paper 000; project's own dimensions (its tables are not available)",
 )
 
@@ -147,13 +150,28 @@ def seven_bar_press(
             not close a loop at the start angles.
         AssemblyError: the start position is singular.
     """
-    dims = {k: positive(k, v) for k, v in (("crank2_length", crank2_length), ("rod3_length", rod3_length),
-            ("plate4_length", plate4_length), ("crank7_length", crank7_length), ("rod5_length", rod5_length))}
+    dims = {
+        k: positive(k, v)
+        for k, v in (
+            ("crank2_length", crank2_length),
+            ("rod3_length", rod3_length),
+            ("plate4_length", plate4_length),
+            ("crank7_length", crank7_length),
+            ("rod5_length", rod5_length),
+        )
+    }
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(clearance_at, PRESS_INFO.clearable, radial_clearance=radial_clearance,
-                           bearing_radius=bearing_radius, restitution=restitution, friction=friction, law=law,
-                           material=material)
+    clr = ClearanceFactory(
+        clearance_at,
+        PRESS_INFO.clearable,
+        radial_clearance=radial_clearance,
+        bearing_radius=bearing_radius,
+        restitution=restitution,
+        friction=friction,
+        law=law,
+        material=material,
+    )
     drive2 = _drive("crank2", "O2", crank2_speed, crank2_motion, crank2_start_angle)
     if crank7_speed is None:
         crank7_speed = crank2_motion.speed if crank2_motion is not None else crank2_speed
@@ -177,22 +195,41 @@ def seven_bar_press(
         slider_link("slider6", {"D": pd}, mass=ms, inertia=js),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"), clr.revolute("A", "crank2", "A", "rod3", "A"),
-        clr.revolute("B", "rod3", "B", "plate4", "B"), clr.revolute("E", "plate4", "E", "crank7", "E"),
-        clr.revolute("O7", "ground", "O7", "crank7", "O7"), clr.revolute("C", "plate4", "C", "rod5", "C"),
+        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
+        clr.revolute("A", "crank2", "A", "rod3", "A"),
+        clr.revolute("B", "rod3", "B", "plate4", "B"),
+        clr.revolute("E", "plate4", "E", "crank7", "E"),
+        clr.revolute("O7", "ground", "O7", "crank7", "O7"),
+        clr.revolute("C", "plate4", "C", "rod5", "C"),
         clr.revolute("D", "rod5", "D", "slider6", "D"),
         Joint("P6", JointType.PRISMATIC, "ground", "G6", "slider6", "D", axis=(0.0, 1.0)),
     )
-    dims.update(plate4_point=[u, v], crank7_pivot=list(o7), guide_x=float(guide_x), slider_mass=ms,
-                slider_inertia=js, linear_density=lam, crank2_speed=float(crank2_speed),
-                crank2_start_angle=float(crank2_start_angle), crank7_speed=float(crank7_speed),
-                crank7_start_angle=float(crank7_start_angle), **clr.parameters(), gravity=float(gravity))
+    dims.update(
+        plate4_point=[u, v],
+        crank7_pivot=list(o7),
+        guide_x=float(guide_x),
+        slider_mass=ms,
+        slider_inertia=js,
+        linear_density=lam,
+        crank2_speed=float(crank2_speed),
+        crank2_start_angle=float(crank2_start_angle),
+        crank7_speed=float(crank7_speed),
+        crank7_start_angle=float(crank7_start_angle),
+        **clr.parameters(),
+        gravity=float(gravity),
+    )
     if crank2_motion is not None:
         dims["crank2_motion"] = _law_params(crank2_motion)
     if crank7_motion is not None:
         dims["crank7_motion"] = _law_params(crank7_motion)
-    return finish(Mechanism(
-        name=name, links=links, joints=joints, drives=(drive2, drive7),
-        outputs=(Output("slider_y", "slider6", OutputKind.POSITION_Y, point="D"),), gravity=(0.0, -gravity),
-        parameters=dims,
-    ))
+    return finish(
+        Mechanism(
+            name=name,
+            links=links,
+            joints=joints,
+            drives=(drive2, drive7),
+            outputs=(Output("slider_y", "slider6", OutputKind.POSITION_Y, point="D"),),
+            gravity=(0.0, -gravity),
+            parameters=dims,
+        )
+    )

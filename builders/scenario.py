@@ -32,9 +32,9 @@ from pathlib import Path
 from typing import Any
 
 import tomli_w
+
 from clearance.builders._scenario_builder import from_builder
 from clearance.builders._toml_reader import Locator, ScenarioError, Table
-
 from clearance.kinematics import AssemblyError, SingularPositionError, assemble
 from clearance.model import (
     Clearance,
@@ -83,8 +83,9 @@ def loads_scenario(text: str, *, source: str = "<string>") -> Mechanism:
     if mech.has("builder"):
         others = [k for k in ("links", "joints", "drives", "outputs") if top.has(k)]
         if others:
-            raise top.error(others[0], "a scenario that names a builder cannot also define links, joints, "
-                                       "drives or outputs")
+            raise top.error(
+                others[0], "a scenario that names a builder cannot also define links, joints, drives or outputs"
+            )
         top.finish(["mechanism"])
         return from_builder(mech)
     mechanism = _read_full(top, mech)
@@ -104,8 +105,10 @@ def loads_scenario(text: str, *, source: str = "<string>") -> Mechanism:
 def _material(t: Table | None) -> Material:
     if t is None:
         return Material()
-    m = Material(t.number("youngs_modulus", "pressure", Material().youngs_modulus),
-                 t.plain("poisson_ratio", Material().poisson_ratio))
+    m = Material(
+        t.number("youngs_modulus", "pressure", Material().youngs_modulus),
+        t.plain("poisson_ratio", Material().poisson_ratio),
+    )
     t.finish(["youngs_modulus_<pa|mpa|gpa>", "poisson_ratio"])
     return m
 
@@ -121,6 +124,41 @@ def _motion(t: Table) -> MotionLaw:
     return MotionLaw(speed, tuple(harmonics), period)
 
 
+def _read_link(t: Table, ground: str) -> Link:
+    """One ``[[links]]`` table as a `Link`."""
+    if t.has("points"):
+        raise t.error("points", "needs a unit in its name: use points_m or points_mm")
+    pts_t = t.sub("points_m", "points") if t.has("points_m") else t.sub("points_mm", "points")
+    scale = 1e-3 if t.has("points_mm") else 1.0
+    points = {} if pts_t is None else {k: pts_t.convert_pair(k, v, scale) for k, v in pts_t.data.items()}
+    lk_name = t.text("name")
+    pos = t.pair("position_guess", "length", (0.0, 0.0))
+    link: Link = _wrap(
+        t,
+        None,
+        lambda: Link(
+            lk_name,
+            t.number("mass", "mass", 0.0 if lk_name == ground else None),
+            t.number("inertia", "inertia", 0.0 if lk_name == ground else None),
+            com=t.pair("com", "length", (0.0, 0.0)),
+            points=points,
+            pose_guess=(pos[0], pos[1], t.number("angle_guess", "angle", 0.0)),
+        ),
+    )
+    t.finish(
+        [
+            "name",
+            "mass_<kg|g>",
+            "inertia_<kg_m2|g_mm2>",
+            "com_<m|mm>",
+            "position_guess_<m|mm>",
+            "angle_guess_<rad|deg>",
+            "points_<m|mm>",
+        ]
+    )
+    return link
+
+
 def _read_full(top: Table, mech: Table) -> Mechanism:
     name = mech.text("name")
     ground = mech.text("ground", default="ground")
@@ -129,28 +167,27 @@ def _read_full(top: Table, mech: Table) -> Mechanism:
     mech.finish(["name", "ground", "gravity_m_per_s2", "parameters", "builder"])
     links, link_tables = [], {}
     for t in top.array("links"):
-        if t.has("points"):
-            raise t.error("points", "needs a unit in its name: use points_m or points_mm")
-        pts_t = t.sub("points_m", "points") if t.has("points_m") else t.sub("points_mm", "points")
-        scale = 1e-3 if t.has("points_mm") else 1.0
-        points = {} if pts_t is None else {k: pts_t.convert_pair(k, v, scale) for k, v in pts_t.data.items()}
-        lk_name = t.text("name")
-        pos = t.pair("position_guess", "length", (0.0, 0.0))
-        link = _wrap(t, None, lambda: Link(
-            lk_name, t.number("mass", "mass", 0.0 if lk_name == ground else None),
-            t.number("inertia", "inertia", 0.0 if lk_name == ground else None),
-            com=t.pair("com", "length", (0.0, 0.0)), points=points,
-            pose_guess=(pos[0], pos[1], t.number("angle_guess", "angle", 0.0))))
-        t.finish(["name", "mass_<kg|g>", "inertia_<kg_m2|g_mm2>", "com_<m|mm>", "position_guess_<m|mm>",
-                  "angle_guess_<rad|deg>", "points_<m|mm>"])
+        link = _read_link(t, ground)
         links.append(link)
-        link_tables[lk_name] = link
+        link_tables[link.name] = link
     joints = [_joint(t, link_tables) for t in top.array("joints")]
     drives = [_drive(t, {j.name for j in joints}) for t in top.array("drives")]
     outputs = [_output(t, link_tables) for t in top.array("outputs")]
     top.finish(["mechanism", "links", "joints", "drives", "outputs"])
-    return _wrap(mech, None, lambda: Mechanism(name, tuple(links), tuple(joints), tuple(drives), tuple(outputs),
-                                               ground=ground, gravity=gravity, parameters=params))
+    return _wrap(
+        mech,
+        None,
+        lambda: Mechanism(
+            name,
+            tuple(links),
+            tuple(joints),
+            tuple(drives),
+            tuple(outputs),
+            ground=ground,
+            gravity=gravity,
+            parameters=params,
+        ),
+    )
 
 
 def _wrap(t: Table, key: str | None, make: Any) -> Any:
@@ -186,14 +223,32 @@ def _joint(t: Table, links: dict[str, Link]) -> Joint:
         journal = c.text("journal_link", default="") or None
         if journal is not None and journal not in (la, lb):
             raise c.error("journal_link", f"must be '{la}' or '{lb}' (got '{journal}')")
-        clearance = _wrap(c, None, lambda: Clearance(
-            c.number("radial_clearance", "length"), c.number("bearing_radius", "length", 0.010), journal,
-            _material(c.sub("bearing_material", "bearing_material")),
-            _material(c.sub("journal_material", "journal_material")), c.plain("restitution", 0.9),
-            c.plain("friction", 0.0), ContactLaw(c.text("law", default=ContactLaw.LANKARANI_NIKRAVESH.value,
-                                                         choices=_LAWS))))
-        c.finish(["radial_clearance_<m|mm|um>", "bearing_radius_<m|mm>", "journal_link", "restitution", "friction",
-                  "law", "bearing_material", "journal_material"])
+        clearance = _wrap(
+            c,
+            None,
+            lambda: Clearance(
+                c.number("radial_clearance", "length"),
+                c.number("bearing_radius", "length", 0.010),
+                journal,
+                _material(c.sub("bearing_material", "bearing_material")),
+                _material(c.sub("journal_material", "journal_material")),
+                c.plain("restitution", 0.9),
+                c.plain("friction", 0.0),
+                ContactLaw(c.text("law", default=ContactLaw.LANKARANI_NIKRAVESH.value, choices=_LAWS)),
+            ),
+        )
+        c.finish(
+            [
+                "radial_clearance_<m|mm|um>",
+                "bearing_radius_<m|mm>",
+                "journal_link",
+                "restitution",
+                "friction",
+                "law",
+                "bearing_material",
+                "journal_material",
+            ]
+        )
     t.finish(["name", "kind", "link_a", "point_a", "link_b", "point_b", "axis", "clearance"])
     return _wrap(t, None, lambda: Joint(name, kind, la, pa, lb, pb, axis=axis, clearance=clearance))
 
@@ -206,11 +261,22 @@ def _drive(t: Table, joints: set[str]) -> Drive:
     kind = DriveKind(t.text("kind", default="constant_speed", choices=[k.value for k in DriveKind]))
     m = t.sub("motion", "motion")
     motion = None if m is None else _motion(m)
-    drive = _wrap(t, None, lambda: Drive(name, joint, kind, speed=t.number("speed", "angular_speed", 0.0),
-                                         start_angle=t.number("start_angle", "angle", 0.0), motion=motion,
-                                         torque=t.number("torque", "torque", 0.0)))
-    t.finish(["name", "joint", "kind", "speed_<rad_per_s|rpm|deg_per_s>", "start_angle_<rad|deg>", "torque_n_m",
-              "motion"])
+    drive = _wrap(
+        t,
+        None,
+        lambda: Drive(
+            name,
+            joint,
+            kind,
+            speed=t.number("speed", "angular_speed", 0.0),
+            start_angle=t.number("start_angle", "angle", 0.0),
+            motion=motion,
+            torque=t.number("torque", "torque", 0.0),
+        ),
+    )
+    t.finish(
+        ["name", "joint", "kind", "speed_<rad_per_s|rpm|deg_per_s>", "start_angle_<rad|deg>", "torque_n_m", "motion"]
+    )
     return drive
 
 
@@ -228,37 +294,69 @@ def _material_doc(m: Material) -> dict[str, Any]:
 
 def scenario_document(mechanism: Mechanism) -> dict[str, Any]:
     """The full-form scenario of a mechanism as a TOML-ready dict (SI units)."""
-    mech: dict[str, Any] = {"name": mechanism.name, "ground": mechanism.ground,
-                            "gravity_m_per_s2": list(mechanism.gravity)}
+    mech: dict[str, Any] = {
+        "name": mechanism.name,
+        "ground": mechanism.ground,
+        "gravity_m_per_s2": list(mechanism.gravity),
+    }
     if mechanism.parameters:
         mech["parameters"] = dict(mechanism.parameters)
-    links = [{"name": lk.name, "mass_kg": lk.mass, "inertia_kg_m2": lk.inertia, "com_m": list(lk.com),
-              "position_guess_m": list(lk.pose_guess[:2]), "angle_guess_rad": lk.pose_guess[2],
-              "points_m": {k: list(v) for k, v in lk.points.items()}} for lk in mechanism.links]
+    links = [
+        {
+            "name": lk.name,
+            "mass_kg": lk.mass,
+            "inertia_kg_m2": lk.inertia,
+            "com_m": list(lk.com),
+            "position_guess_m": list(lk.pose_guess[:2]),
+            "angle_guess_rad": lk.pose_guess[2],
+            "points_m": {k: list(v) for k, v in lk.points.items()},
+        }
+        for lk in mechanism.links
+    ]
     joints = []
     for j in mechanism.joints:
-        d: dict[str, Any] = {"name": j.name, "kind": j.kind.value, "link_a": j.link_a, "point_a": j.point_a,
-                             "link_b": j.link_b, "point_b": j.point_b}
+        d: dict[str, Any] = {
+            "name": j.name,
+            "kind": j.kind.value,
+            "link_a": j.link_a,
+            "point_a": j.point_a,
+            "link_b": j.link_b,
+            "point_b": j.point_b,
+        }
         if j.kind is JointType.PRISMATIC:
             d["axis"] = list(j.axis)
         c = j.clearance
         if c is not None:
-            d["clearance"] = {"radial_clearance_m": c.radial_clearance, "bearing_radius_m": c.bearing_radius,
-                              "journal_link": c.journal_link, "restitution": c.restitution, "friction": c.friction,
-                              "law": c.law.value, "bearing_material": _material_doc(c.bearing_material),
-                              "journal_material": _material_doc(c.journal_material)}
+            d["clearance"] = {
+                "radial_clearance_m": c.radial_clearance,
+                "bearing_radius_m": c.bearing_radius,
+                "journal_link": c.journal_link,
+                "restitution": c.restitution,
+                "friction": c.friction,
+                "law": c.law.value,
+                "bearing_material": _material_doc(c.bearing_material),
+                "journal_material": _material_doc(c.journal_material),
+            }
         joints.append(d)
     drives = []
     for dr in mechanism.drives:
-        d = {"name": dr.name, "joint": dr.joint, "kind": dr.kind.value, "speed_rad_per_s": dr.speed,
-             "start_angle_rad": dr.start_angle, "torque_n_m": dr.torque}
+        d = {
+            "name": dr.name,
+            "joint": dr.joint,
+            "kind": dr.kind.value,
+            "speed_rad_per_s": dr.speed,
+            "start_angle_rad": dr.start_angle,
+            "torque_n_m": dr.torque,
+        }
         if dr.motion is not None:
             d["motion"] = {"speed_rad_per_s": dr.motion.speed, "harmonics_rad": [list(h) for h in dr.motion.harmonics]}
             if dr.motion.period is not None:
                 d["motion"]["period_s"] = dr.motion.period
         drives.append(d)
-    outputs = [{"name": o.name, "link": o.link, "kind": o.kind.value, **({"point": o.point} if o.point else {})}
-               for o in mechanism.outputs]
+    outputs = [
+        {"name": o.name, "link": o.link, "kind": o.kind.value, **({"point": o.point} if o.point else {})}
+        for o in mechanism.outputs
+    ]
     return {"mechanism": mech, "links": links, "joints": joints, "drives": drives, "outputs": outputs}
 
 
@@ -271,8 +369,10 @@ def dumps_scenario(mechanism: Mechanism) -> str:
     try:
         return _HEADER + _compact(tomli_w.dumps(scenario_document(mechanism)))
     except TypeError as e:
-        raise ValueError(f"mechanism '{mechanism.name}' cannot be written as TOML: {e} "
-                         "(parameters must be strings, numbers, booleans, lists or tables)") from None
+        raise ValueError(
+            f"mechanism '{mechanism.name}' cannot be written as TOML: {e} "
+            "(parameters must be strings, numbers, booleans, lists or tables)"
+        ) from None
 
 
 _ITEM = r'(?:-?(?:\d[\d_]*(?:\.\d*)?(?:[eE][+-]?\d+)?|inf|nan)|"[A-Za-z0-9_.\-]*"|true|false|\[[^\[\]\n]*\])'

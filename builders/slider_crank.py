@@ -12,6 +12,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from clearance.checks import positive
 from clearance.model import (
     STEEL,
     Clearance,
@@ -95,22 +96,19 @@ def slider_crank(
     """
     unknown = [j for j in clearance_at if j not in _CLEARABLE]
     if unknown:
-        raise ValueError(
-            f"clearance_at: unknown joint(s) {unknown}; expected any of {list(_CLEARABLE)}"
-        )
-    for field_name, v in (("crank_length", crank_length), ("rod_length", rod_length)):
-        if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-            raise ValueError(f"{field_name} must be > 0 (got {v!r} m)")
+        raise ValueError(f"clearance_at: unknown joint(s) {unknown}; expected any of {list(_CLEARABLE)}")
+    positive("crank_length", crank_length, "m")
+    positive("rod_length", rod_length, "m")
     if rod_length <= crank_length:
         raise ValueError(
             f"rod_length must be > crank_length = {crank_length} m for the slider-crank to "
             f"assemble over a whole revolution (got {rod_length} m)"
         )
-    r, l = crank_length, rod_length
+    r, rod = crank_length, rod_length
     th = start_angle
     bx, by = r * math.cos(th), r * math.sin(th)
-    beta = math.asin(-by / l)
-    sx = bx + l * math.cos(beta)
+    beta = math.asin(-by / rod)
+    sx = bx + rod * math.cos(beta)
     links = (
         Link("ground", 0.0, 0.0, points={"crank_pivot": (0.0, 0.0), "guide": (0.0, 0.0)}),
         Link(
@@ -125,8 +123,8 @@ def slider_crank(
             "rod",
             rod_mass,
             rod_inertia,
-            com=(l / 2, 0.0),
-            points={"big_end": (0.0, 0.0), "small_end": (l, 0.0)},
+            com=(rod / 2, 0.0),
+            points={"big_end": (0.0, 0.0), "small_end": (rod, 0.0)},
             pose_guess=(bx, by, beta),
         ),
         Link(
@@ -157,13 +155,11 @@ def slider_crank(
         Joint("rod_slider", JointType.REVOLUTE, "rod", "small_end", "slider", "pin", clearance=clr("rod_slider")),
         Joint("slider_guide", JointType.PRISMATIC, "ground", "guide", "slider", "pin", axis=(1.0, 0.0)),
     )
-    drives = (
-        Drive("crank", "crank_pivot", DriveKind.CONSTANT_SPEED, speed=crank_speed, start_angle=th),
-    )
+    drives = (Drive("crank", "crank_pivot", DriveKind.CONSTANT_SPEED, speed=crank_speed, start_angle=th),)
     outputs = (Output("slider_x", "slider", OutputKind.POSITION_X, point="pin"),)
     params = {
         "crank_length": r,
-        "rod_length": l,
+        "rod_length": rod,
         "crank_mass": crank_mass,
         "rod_mass": rod_mass,
         "slider_mass": slider_mass,

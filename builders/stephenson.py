@@ -47,7 +47,6 @@ from clearance.builders._linkage import (
     slider_link,
 )
 from clearance.builders.slider_crank import rpm
-
 from clearance.kinematics import TransmissionAngle as _T
 from clearance.model import (
     STEEL,
@@ -79,16 +78,23 @@ _LN = ContactLaw.LANKARANI_NIKRAVESH
 STEPHENSON_I_INFO = LinkageInfo(
     topology="Stephenson I: ground 1 (binary: O2, O4), ternary crank 2 (O2, A, E; driven), coupler 3 "
     "(A-B), ternary rocker 4 (O4, B, F; output: its angle), link 5 (E-G), link 6 (G-F).",
-    driven=("O2",), output_pivot="O4", clearable=("A", "B", "O4", "E", "G", "F"),
+    driven=("O2",),
+    output_pivot="O4",
+    clearable=("A", "B", "O4", "E", "G", "F"),
     criticality=("A", "B", "E", "G", "F"),
-    transmission=(_T("B", ("coupler3", "A"), follower=("rocker4", "O4")), _T("G", ("link5", "E"), follower=("link6", "F"))),
+    transmission=(
+        _T("B", ("coupler3", "A"), follower=("rocker4", "O4")),
+        _T("G", ("link5", "E"), follower=("link6", "F")),
+    ),
     provenance=_OWN,
 )
 STEPHENSON_I_SLIDER_INFO = LinkageInfo(
     topology="Stephenson I with slider: ground 1 (binary: O2, guide P4), ternary crank 2 (O2, A, E; "
     "driven), rod 3 (A-B), ternary slider 4 (pins B, F; horizontal guide; output: its x), "
     "link 5 (E-G), link 6 (G-F).",
-    driven=("O2",), output_pivot="P4", clearable=("A", "B", "E", "G", "F"),
+    driven=("O2",),
+    output_pivot="P4",
+    clearable=("A", "B", "E", "G", "F"),
     criticality=("A", "B", "E", "G", "F"),
     transmission=(_T("B", ("rod3", "A"), guide="P4"), _T("G", ("link5", "E"), follower=("link6", "F"))),
     provenance=_OWN,
@@ -96,45 +102,110 @@ STEPHENSON_I_SLIDER_INFO = LinkageInfo(
 STEPHENSON_II_1_INFO = LinkageInfo(
     topology="Stephenson II (1): ground 1 (ternary: O2, O4, O6), crank 2 (O2-A, driven), ternary "
     "coupler 3 (A, B, C), rocker 4 (O4-B), link 5 (C-D), rocker 6 (O6-D, output: its angle).",
-    driven=("O2",), output_pivot="O6", clearable=("A", "B", "O4", "C", "D", "O6"),
+    driven=("O2",),
+    output_pivot="O6",
+    clearable=("A", "B", "O4", "C", "D", "O6"),
     criticality=("A", "B", "O4", "C", "D"),
-    transmission=(_T("B", ("coupler3", "A"), follower=("rocker4", "O4")), _T("D", ("link5", "C"), follower=("rocker6", "O6"))),
+    transmission=(
+        _T("B", ("coupler3", "A"), follower=("rocker4", "O4")),
+        _T("D", ("link5", "C"), follower=("rocker6", "O6")),
+    ),
     provenance=_OWN,
 )
 STEPHENSON_II_2_INFO = LinkageInfo(
     topology="Stephenson II (2): ground 1 (ternary: O2, O5, O6), crank 2 (O2-A, driven), rod 3 (A-B), "
     "ternary coupler 4 (B, C, D), rocker 5 (O5-C, output: its angle), rocker 6 (O6-D).",
-    driven=("O2",), output_pivot="O5", clearable=("A", "B", "C", "O5", "D", "O6"),
+    driven=("O2",),
+    output_pivot="O5",
+    clearable=("A", "B", "C", "O5", "D", "O6"),
     criticality=("A", "B", "C", "D", "O6"),
-    transmission=(_T("C", ("coupler4", "D"), follower=("rocker5", "O5")), _T("D", ("coupler4", "C"), follower=("rocker6", "O6"))),
+    transmission=(
+        _T("C", ("coupler4", "D"), follower=("rocker5", "O5")),
+        _T("D", ("coupler4", "C"), follower=("rocker6", "O6")),
+    ),
     provenance=_OWN + "; near-parallelogram double rocker with the rod along the coupler",
 )
 
 
-def _setup(info: LinkageInfo, clearance_at: Sequence[str], radial_clearance: float, bearing_radius: float,
-           restitution: float, friction: float, law: ContactLaw, material: Material) -> ClearanceFactory:
-    return ClearanceFactory(clearance_at, info.clearable, radial_clearance=radial_clearance,
-                            bearing_radius=bearing_radius, restitution=restitution, friction=friction, law=law,
-                            material=material)
+def _setup(
+    info: LinkageInfo,
+    clearance_at: Sequence[str],
+    radial_clearance: float,
+    bearing_radius: float,
+    restitution: float,
+    friction: float,
+    law: ContactLaw,
+    material: Material,
+) -> ClearanceFactory:
+    return ClearanceFactory(
+        clearance_at,
+        info.clearable,
+        radial_clearance=radial_clearance,
+        bearing_radius=bearing_radius,
+        restitution=restitution,
+        friction=friction,
+        law=law,
+        material=material,
+    )
 
 
-def _build(name: str, links: Sequence[Link], joints: Sequence[Joint], output: Output, crank_speed: float,
-           start_angle: float, gravity: float, lam: float, clr: ClearanceFactory, dims: dict) -> Mechanism:
-    params = {**dims, "linear_density": lam, "crank_speed": float(crank_speed), "start_angle": float(start_angle),
-              **clr.parameters(), "gravity": float(gravity)}
-    return finish(Mechanism(name=name, links=tuple(links), joints=tuple(joints),
-                            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-                            outputs=(output,), gravity=(0.0, -gravity), parameters=params))
+def _build(
+    name: str,
+    links: Sequence[Link],
+    joints: Sequence[Joint],
+    output: Output,
+    crank_speed: float,
+    start_angle: float,
+    gravity: float,
+    lam: float,
+    clr: ClearanceFactory,
+    dims: dict,
+) -> Mechanism:
+    params = {
+        **dims,
+        "linear_density": lam,
+        "crank_speed": float(crank_speed),
+        "start_angle": float(start_angle),
+        **clr.parameters(),
+        "gravity": float(gravity),
+    }
+    return finish(
+        Mechanism(
+            name=name,
+            links=tuple(links),
+            joints=tuple(joints),
+            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
+            outputs=(output,),
+            gravity=(0.0, -gravity),
+            parameters=params,
+        )
+    )
 
 
 def stephenson_i(
-    *, crank_length: float = 0.04, crank_arm: float = 0.03, crank_arm_angle: float = math.radians(-45.0),
-    coupler3_length: float = 0.13, rocker4_length: float = 0.10, ground_length: float = 0.13,
-    rocker4_arm: float = 0.07, rocker4_arm_angle: float = math.radians(-60.0), link5_length: float = 0.14,
-    link6_length: float = 0.12, linear_density: float = _LAM, crank_speed: float = rpm(1000.0),
-    start_angle: float = 0.0, clearance_at: Sequence[str] = ("B",), radial_clearance: float = _C,
-    bearing_radius: float = 0.010, restitution: float = 0.9, friction: float = 0.0, law: ContactLaw = _LN,
-    material: Material = STEEL, gravity: float = 0.0, name: str = "stephenson_i",
+    *,
+    crank_length: float = 0.04,
+    crank_arm: float = 0.03,
+    crank_arm_angle: float = math.radians(-45.0),
+    coupler3_length: float = 0.13,
+    rocker4_length: float = 0.10,
+    ground_length: float = 0.13,
+    rocker4_arm: float = 0.07,
+    rocker4_arm_angle: float = math.radians(-60.0),
+    link5_length: float = 0.14,
+    link6_length: float = 0.12,
+    linear_density: float = _LAM,
+    crank_speed: float = rpm(1000.0),
+    start_angle: float = 0.0,
+    clearance_at: Sequence[str] = ("B",),
+    radial_clearance: float = _C,
+    bearing_radius: float = 0.010,
+    restitution: float = 0.9,
+    friction: float = 0.0,
+    law: ContactLaw = _LN,
+    material: Material = STEEL,
+    gravity: float = 0.0,
+    name: str = "stephenson_i",
 ) -> Mechanism:
     """Build the Stephenson I six-bar (four-bar plus a dyad from crank to rocker).
 
@@ -160,11 +231,23 @@ def stephenson_i(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {k: positive(k, v) for k, v in (("crank_length", crank_length), ("crank_arm", crank_arm),
-            ("coupler3_length", coupler3_length), ("rocker4_length", rocker4_length), ("ground_length", ground_length),
-            ("rocker4_arm", rocker4_arm), ("link5_length", link5_length), ("link6_length", link6_length))}
+    dims = {
+        k: positive(k, v)
+        for k, v in (
+            ("crank_length", crank_length),
+            ("crank_arm", crank_arm),
+            ("coupler3_length", coupler3_length),
+            ("rocker4_length", rocker4_length),
+            ("ground_length", ground_length),
+            ("rocker4_arm", rocker4_arm),
+            ("link5_length", link5_length),
+            ("link6_length", link6_length),
+        )
+    }
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = _setup(STEPHENSON_I_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction, law, material)
+    clr = _setup(
+        STEPHENSON_I_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction, law, material
+    )
     o2, o4 = (0.0, 0.0), (ground_length, 0.0)
     pa, pe = polar(o2, crank_length, start_angle), polar(o2, crank_arm, start_angle + crank_arm_angle)
     pb = circle_circle(pa, coupler3_length, o4, rocker4_length, left=True, what="coupler 3 / rocker 4")
@@ -179,24 +262,52 @@ def stephenson_i(
         bar_link("link6", {"G": pg, "F": pf}, density=lam),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"), clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"), clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("E", "crank2", "E", "link5", "E"), clr.revolute("G", "link5", "G", "link6", "G"),
+        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
+        clr.revolute("A", "crank2", "A", "coupler3", "A"),
+        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
+        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
+        clr.revolute("E", "crank2", "E", "link5", "E"),
+        clr.revolute("G", "link5", "G", "link6", "G"),
         clr.revolute("F", "link6", "F", "rocker4", "F"),
     )
     dims.update(crank_arm_angle=float(crank_arm_angle), rocker4_arm_angle=float(rocker4_arm_angle))
-    return _build(name, links, joints, Output("rocker_angle", "rocker4", OutputKind.ANGLE), crank_speed,
-                  start_angle, gravity, lam, clr, dims)
+    return _build(
+        name,
+        links,
+        joints,
+        Output("rocker_angle", "rocker4", OutputKind.ANGLE),
+        crank_speed,
+        start_angle,
+        gravity,
+        lam,
+        clr,
+        dims,
+    )
 
 
 def stephenson_i_slider(
-    *, crank_length: float = 0.04, crank_arm: float = 0.03, crank_arm_angle: float = math.radians(-45.0),
-    rod3_length: float = 0.13, slider_pin_offset: tuple[float, float] = (0.0, -0.05), link5_length: float = 0.10,
-    link6_length: float = 0.10, slider_mass: float = 0.2, slider_inertia: float = 3.3e-5,
-    linear_density: float = _LAM, crank_speed: float = rpm(1000.0), start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("B",), radial_clearance: float = _C, bearing_radius: float = 0.010,
-    restitution: float = 0.9, friction: float = 0.0, law: ContactLaw = _LN, material: Material = STEEL,
-    gravity: float = 0.0, name: str = "stephenson_i_slider",
+    *,
+    crank_length: float = 0.04,
+    crank_arm: float = 0.03,
+    crank_arm_angle: float = math.radians(-45.0),
+    rod3_length: float = 0.13,
+    slider_pin_offset: tuple[float, float] = (0.0, -0.05),
+    link5_length: float = 0.10,
+    link6_length: float = 0.10,
+    slider_mass: float = 0.2,
+    slider_inertia: float = 3.3e-5,
+    linear_density: float = _LAM,
+    crank_speed: float = rpm(1000.0),
+    start_angle: float = 0.0,
+    clearance_at: Sequence[str] = ("B",),
+    radial_clearance: float = _C,
+    bearing_radius: float = 0.010,
+    restitution: float = 0.9,
+    friction: float = 0.0,
+    law: ContactLaw = _LN,
+    material: Material = STEEL,
+    gravity: float = 0.0,
+    name: str = "stephenson_i_slider",
 ) -> Mechanism:
     """Build the Stephenson I six-bar with an output slider (in-line, on the x axis).
 
@@ -217,12 +328,21 @@ def stephenson_i_slider(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {k: positive(k, v) for k, v in (("crank_length", crank_length), ("crank_arm", crank_arm),
-            ("rod3_length", rod3_length), ("link5_length", link5_length), ("link6_length", link6_length))}
+    dims = {
+        k: positive(k, v)
+        for k, v in (
+            ("crank_length", crank_length),
+            ("crank_arm", crank_arm),
+            ("rod3_length", rod3_length),
+            ("link5_length", link5_length),
+            ("link6_length", link6_length),
+        )
+    }
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = _setup(STEPHENSON_I_SLIDER_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction,
-                 law, material)
+    clr = _setup(
+        STEPHENSON_I_SLIDER_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction, law, material
+    )
     o2 = (0.0, 0.0)
     pa, pe = polar(o2, crank_length, start_angle), polar(o2, crank_arm, start_angle + crank_arm_angle)
     pb = line_circle(o2, (1.0, 0.0), pa, rod3_length, forward=True, what="rod 3 / slider 4")
@@ -238,25 +358,51 @@ def stephenson_i_slider(
         bar_link("link6", {"G": pg, "F": pf}, density=lam),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"), clr.revolute("A", "crank2", "A", "rod3", "A"),
+        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
+        clr.revolute("A", "crank2", "A", "rod3", "A"),
         clr.revolute("B", "rod3", "B", "slider4", "B"),
         Joint("P4", JointType.PRISMATIC, "ground", "G4", "slider4", "B", axis=(1.0, 0.0)),
-        clr.revolute("E", "crank2", "E", "link5", "E"), clr.revolute("G", "link5", "G", "link6", "G"),
+        clr.revolute("E", "crank2", "E", "link5", "E"),
+        clr.revolute("G", "link5", "G", "link6", "G"),
         clr.revolute("F", "link6", "F", "slider4", "F"),
     )
-    dims.update(crank_arm_angle=float(crank_arm_angle), slider_pin_offset=list(off), slider_mass=ms,
-                slider_inertia=js)
-    return _build(name, links, joints, Output("slider_x", "slider4", OutputKind.POSITION_X, point="B"),
-                  crank_speed, start_angle, gravity, lam, clr, dims)
+    dims.update(crank_arm_angle=float(crank_arm_angle), slider_pin_offset=list(off), slider_mass=ms, slider_inertia=js)
+    return _build(
+        name,
+        links,
+        joints,
+        Output("slider_x", "slider4", OutputKind.POSITION_X, point="B"),
+        crank_speed,
+        start_angle,
+        gravity,
+        lam,
+        clr,
+        dims,
+    )
 
 
 def stephenson_ii_1(
-    *, crank_length: float = 0.04, coupler3_length: float = 0.13, rocker4_length: float = 0.10,
-    ground_length: float = 0.13, coupler3_point: tuple[float, float] = (0.16, 0.0), link5_length: float = 0.16,
-    rocker6_length: float = 0.10, rocker6_pivot: tuple[float, float] = (0.21, -0.05), linear_density: float = _LAM,
-    crank_speed: float = rpm(1000.0), start_angle: float = 0.0, clearance_at: Sequence[str] = ("D",),
-    radial_clearance: float = _C, bearing_radius: float = 0.010, restitution: float = 0.9, friction: float = 0.0,
-    law: ContactLaw = _LN, material: Material = STEEL, gravity: float = 0.0, name: str = "stephenson_ii_1",
+    *,
+    crank_length: float = 0.04,
+    coupler3_length: float = 0.13,
+    rocker4_length: float = 0.10,
+    ground_length: float = 0.13,
+    coupler3_point: tuple[float, float] = (0.16, 0.0),
+    link5_length: float = 0.16,
+    rocker6_length: float = 0.10,
+    rocker6_pivot: tuple[float, float] = (0.21, -0.05),
+    linear_density: float = _LAM,
+    crank_speed: float = rpm(1000.0),
+    start_angle: float = 0.0,
+    clearance_at: Sequence[str] = ("D",),
+    radial_clearance: float = _C,
+    bearing_radius: float = 0.010,
+    restitution: float = 0.9,
+    friction: float = 0.0,
+    law: ContactLaw = _LN,
+    material: Material = STEEL,
+    gravity: float = 0.0,
+    name: str = "stephenson_ii_1",
 ) -> Mechanism:
     """Build Stephenson II (1): a crank-rocker whose coupler point drives a dyad to rocker 6.
 
@@ -276,12 +422,21 @@ def stephenson_ii_1(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {k: positive(k, v) for k, v in (("crank_length", crank_length), ("coupler3_length", coupler3_length),
-            ("rocker4_length", rocker4_length), ("ground_length", ground_length), ("link5_length", link5_length),
-            ("rocker6_length", rocker6_length))}
+    dims = {
+        k: positive(k, v)
+        for k, v in (
+            ("crank_length", crank_length),
+            ("coupler3_length", coupler3_length),
+            ("rocker4_length", rocker4_length),
+            ("ground_length", ground_length),
+            ("link5_length", link5_length),
+            ("rocker6_length", rocker6_length),
+        )
+    }
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = _setup(STEPHENSON_II_1_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction,
-                 law, material)
+    clr = _setup(
+        STEPHENSON_II_1_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction, law, material
+    )
     o2, o4, o6 = (0.0, 0.0), (ground_length, 0.0), (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
     pa = polar(o2, crank_length, start_angle)
     pb = circle_circle(pa, coupler3_length, o4, rocker4_length, left=True, what="coupler 3 / rocker 4")
@@ -298,24 +453,51 @@ def stephenson_ii_1(
         bar_link("rocker6", {"O6": o6, "D": pd}, density=lam),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"), clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"), clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("C", "coupler3", "C", "link5", "C"), clr.revolute("D", "link5", "D", "rocker6", "D"),
+        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
+        clr.revolute("A", "crank2", "A", "coupler3", "A"),
+        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
+        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
+        clr.revolute("C", "coupler3", "C", "link5", "C"),
+        clr.revolute("D", "link5", "D", "rocker6", "D"),
         clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
     )
     dims.update(coupler3_point=[u, v], rocker6_pivot=list(o6))
-    return _build(name, links, joints, Output("rocker_angle", "rocker6", OutputKind.ANGLE), crank_speed,
-                  start_angle, gravity, lam, clr, dims)
+    return _build(
+        name,
+        links,
+        joints,
+        Output("rocker_angle", "rocker6", OutputKind.ANGLE),
+        crank_speed,
+        start_angle,
+        gravity,
+        lam,
+        clr,
+        dims,
+    )
 
 
 def stephenson_ii_2(
-    *, crank_length: float = 0.03, rod3_length: float = 0.22, coupler4_length: float = 0.10,
-    coupler4_point: tuple[float, float] = (0.05, -0.03), rocker5_length: float = 0.10, rocker6_length: float = 0.12,
-    rocker5_pivot: tuple[float, float] = (0.20, 0.10), rocker6_pivot: tuple[float, float] = (0.30, 0.12),
-    linear_density: float = _LAM, crank_speed: float = rpm(1000.0), start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("B",), radial_clearance: float = _C, bearing_radius: float = 0.010,
-    restitution: float = 0.9, friction: float = 0.0, law: ContactLaw = _LN, material: Material = STEEL,
-    gravity: float = 0.0, name: str = "stephenson_ii_2",
+    *,
+    crank_length: float = 0.03,
+    rod3_length: float = 0.22,
+    coupler4_length: float = 0.10,
+    coupler4_point: tuple[float, float] = (0.05, -0.03),
+    rocker5_length: float = 0.10,
+    rocker6_length: float = 0.12,
+    rocker5_pivot: tuple[float, float] = (0.20, 0.10),
+    rocker6_pivot: tuple[float, float] = (0.30, 0.12),
+    linear_density: float = _LAM,
+    crank_speed: float = rpm(1000.0),
+    start_angle: float = 0.0,
+    clearance_at: Sequence[str] = ("B",),
+    radial_clearance: float = _C,
+    bearing_radius: float = 0.010,
+    restitution: float = 0.9,
+    friction: float = 0.0,
+    law: ContactLaw = _LN,
+    material: Material = STEEL,
+    gravity: float = 0.0,
+    name: str = "stephenson_ii_2",
 ) -> Mechanism:
     """Build Stephenson II (2): crank and rod drive the coupler of a double rocker.
 
@@ -337,12 +519,20 @@ def stephenson_ii_2(
         ValueError: a value out of range or an unknown clearance joint.
         AssemblyError: the loops cannot be closed, or the start position is singular.
     """
-    dims = {k: positive(k, v) for k, v in (("crank_length", crank_length), ("rod3_length", rod3_length),
-            ("coupler4_length", coupler4_length), ("rocker5_length", rocker5_length),
-            ("rocker6_length", rocker6_length))}
+    dims = {
+        k: positive(k, v)
+        for k, v in (
+            ("crank_length", crank_length),
+            ("rod3_length", rod3_length),
+            ("coupler4_length", coupler4_length),
+            ("rocker5_length", rocker5_length),
+            ("rocker6_length", rocker6_length),
+        )
+    }
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = _setup(STEPHENSON_II_2_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction,
-                 law, material)
+    clr = _setup(
+        STEPHENSON_II_2_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction, law, material
+    )
     o2 = (0.0, 0.0)
     o5, o6 = (float(rocker5_pivot[0]), float(rocker5_pivot[1])), (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
     # rough pose at crank angle 0 (rockers hanging down, coupler horizontal); Newton closes it
@@ -360,17 +550,34 @@ def stephenson_ii_2(
         bar_link("rocker6", {"O6": o6, "D": pd}, density=lam),
     )
     # the rough pose fixes the lengths of rod 3 and rocker 6 only approximately: set them exactly
-    links = (*links[:2], _resized(links[2], "A", "B", rod3_length, lam), *links[3:5],
-             _resized(links[5], "O6", "D", rocker6_length, lam))
+    links = (
+        *links[:2],
+        _resized(links[2], "A", "B", rod3_length, lam),
+        *links[3:5],
+        _resized(links[5], "O6", "D", rocker6_length, lam),
+    )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"), clr.revolute("A", "crank2", "A", "rod3", "A"),
-        clr.revolute("B", "rod3", "B", "coupler4", "B"), clr.revolute("C", "coupler4", "C", "rocker5", "C"),
-        clr.revolute("O5", "ground", "O5", "rocker5", "O5"), clr.revolute("D", "coupler4", "D", "rocker6", "D"),
+        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
+        clr.revolute("A", "crank2", "A", "rod3", "A"),
+        clr.revolute("B", "rod3", "B", "coupler4", "B"),
+        clr.revolute("C", "coupler4", "C", "rocker5", "C"),
+        clr.revolute("O5", "ground", "O5", "rocker5", "O5"),
+        clr.revolute("D", "coupler4", "D", "rocker6", "D"),
         clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
     )
     dims.update(coupler4_point=[u, v], rocker5_pivot=list(o5), rocker6_pivot=list(o6))
-    mech = _build(name, links, joints, Output("rocker_angle", "rocker5", OutputKind.ANGLE), crank_speed, 0.0,
-                  gravity, lam, clr, dims)
+    mech = _build(
+        name,
+        links,
+        joints,
+        Output("rocker_angle", "rocker5", OutputKind.ANGLE),
+        crank_speed,
+        0.0,
+        gravity,
+        lam,
+        clr,
+        dims,
+    )
     mech = advance(mech, float(start_angle))
     return _with_params(mech, start_angle=float(start_angle))
 

@@ -33,7 +33,6 @@ from clearance.builders._linkage import (
     slider_link,
 )
 from clearance.builders.slider_crank import rpm
-
 from clearance.kinematics import TransmissionAngle
 from clearance.model import (
     STEEL,
@@ -110,8 +109,10 @@ def _crank_rocker(a: float, b: float, c: float, d: float, th: float, lam: float)
     o2, o4 = (0.0, 0.0), (d, 0.0)
     pa = polar(o2, a, th)
     pb = circle_circle(pa, b, o4, c, left=True, what="coupler 3 / rocker 4")
-    return [bar_link("crank2", {"O2": o2, "A": pa}, density=lam),
-            bar_link("coupler3", {"A": pa, "B": pb}, density=lam)], {"O2": o2, "O4": o4, "A": pa, "B": pb}
+    return [
+        bar_link("crank2", {"O2": o2, "A": pa}, density=lam),
+        bar_link("coupler3", {"A": pa, "B": pb}, density=lam),
+    ], {"O2": o2, "O4": o4, "A": pa, "B": pb}
 
 
 def _common(clr: ClearanceFactory, crank_speed: float, start_angle: float, lam: float, gravity: float) -> dict:
@@ -174,14 +175,34 @@ def watt_six_bar(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    a, b, c, d = (positive(n, v) for n, v in (("crank_length", crank_length), ("coupler3_length", coupler3_length),
-                                              ("rocker4_length", rocker4_length), ("ground_length", ground_length)))
-    e, f, g = (positive(n, v) for n, v in (("rocker4_arm", rocker4_arm), ("coupler5_length", coupler5_length),
-                                           ("rocker6_length", rocker6_length)))
+    a, b, c, d = (
+        positive(n, v)
+        for n, v in (
+            ("crank_length", crank_length),
+            ("coupler3_length", coupler3_length),
+            ("rocker4_length", rocker4_length),
+            ("ground_length", ground_length),
+        )
+    )
+    e, f, g = (
+        positive(n, v)
+        for n, v in (
+            ("rocker4_arm", rocker4_arm),
+            ("coupler5_length", coupler5_length),
+            ("rocker6_length", rocker6_length),
+        )
+    )
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(clearance_at, WATT_INFO.clearable, radial_clearance=radial_clearance,
-                           bearing_radius=bearing_radius, restitution=restitution, friction=friction,
-                           law=law, material=material)
+    clr = ClearanceFactory(
+        clearance_at,
+        WATT_INFO.clearable,
+        radial_clearance=radial_clearance,
+        bearing_radius=bearing_radius,
+        restitution=restitution,
+        friction=friction,
+        law=law,
+        material=material,
+    )
     links, p = _crank_rocker(a, b, c, d, start_angle, lam)
     o6 = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
     th4 = math.atan2(p["B"][1] - p["O4"][1], p["B"][0] - p["O4"][0])
@@ -203,16 +224,29 @@ def watt_six_bar(
         clr.revolute("D", "coupler5", "D", "rocker6", "D"),
         clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
     )
-    params = {"crank_length": a, "coupler3_length": b, "rocker4_length": c, "ground_length": d,
-              "rocker4_arm": e, "rocker4_arm_angle": float(rocker4_arm_angle), "coupler5_length": f,
-              "rocker6_length": g, "rocker6_pivot": list(o6),
-              **_common(clr, crank_speed, start_angle, lam, gravity)}
-    return finish(Mechanism(
-        name=name, links=tuple(links), joints=joints,
-        drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-        outputs=(Output("rocker_angle", "rocker6", OutputKind.ANGLE),),
-        gravity=(0.0, -gravity), parameters=params,
-    ))
+    params = {
+        "crank_length": a,
+        "coupler3_length": b,
+        "rocker4_length": c,
+        "ground_length": d,
+        "rocker4_arm": e,
+        "rocker4_arm_angle": float(rocker4_arm_angle),
+        "coupler5_length": f,
+        "rocker6_length": g,
+        "rocker6_pivot": list(o6),
+        **_common(clr, crank_speed, start_angle, lam, gravity),
+    }
+    return finish(
+        Mechanism(
+            name=name,
+            links=tuple(links),
+            joints=joints,
+            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
+            outputs=(Output("rocker_angle", "rocker6", OutputKind.ANGLE),),
+            gravity=(0.0, -gravity),
+            parameters=params,
+        )
+    )
 
 
 def watt_six_bar_slider_1(
@@ -260,14 +294,28 @@ def watt_six_bar_slider_1(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    a, b, c, d = (positive(n, v) for n, v in (("crank_length", crank_length), ("coupler3_length", coupler3_length),
-                                              ("rocker4_length", rocker4_length), ("ground_length", ground_length)))
+    a, b, c, d = (
+        positive(n, v)
+        for n, v in (
+            ("crank_length", crank_length),
+            ("coupler3_length", coupler3_length),
+            ("rocker4_length", rocker4_length),
+            ("ground_length", ground_length),
+        )
+    )
     e, f = positive("rocker4_arm", rocker4_arm), positive("rod5_length", rod5_length)
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(clearance_at, WATT_SLIDER_1_INFO.clearable, radial_clearance=radial_clearance,
-                           bearing_radius=bearing_radius, restitution=restitution, friction=friction,
-                           law=law, material=material)
+    clr = ClearanceFactory(
+        clearance_at,
+        WATT_SLIDER_1_INFO.clearable,
+        radial_clearance=radial_clearance,
+        bearing_radius=bearing_radius,
+        restitution=restitution,
+        friction=friction,
+        law=law,
+        material=material,
+    )
     links, p = _crank_rocker(a, b, c, d, start_angle, lam)
     th4 = math.atan2(p["B"][1] - p["O4"][1], p["B"][0] - p["O4"][0])
     pc = polar(p["O4"], e, th4 + rocker4_arm_angle)
@@ -289,16 +337,30 @@ def watt_six_bar_slider_1(
         clr.revolute("D", "rod5", "D", "slider6", "D"),
         Joint("P6", JointType.PRISMATIC, "ground", "G6", "slider6", "D", axis=(1.0, 0.0)),
     )
-    params = {"crank_length": a, "coupler3_length": b, "rocker4_length": c, "ground_length": d,
-              "rocker4_arm": e, "rocker4_arm_angle": float(rocker4_arm_angle), "rod5_length": f,
-              "guide_height": float(guide_height), "slider_mass": ms, "slider_inertia": js,
-              **_common(clr, crank_speed, start_angle, lam, gravity)}
-    return finish(Mechanism(
-        name=name, links=tuple(links), joints=joints,
-        drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-        outputs=(Output("slider_x", "slider6", OutputKind.POSITION_X, point="D"),),
-        gravity=(0.0, -gravity), parameters=params,
-    ))
+    params = {
+        "crank_length": a,
+        "coupler3_length": b,
+        "rocker4_length": c,
+        "ground_length": d,
+        "rocker4_arm": e,
+        "rocker4_arm_angle": float(rocker4_arm_angle),
+        "rod5_length": f,
+        "guide_height": float(guide_height),
+        "slider_mass": ms,
+        "slider_inertia": js,
+        **_common(clr, crank_speed, start_angle, lam, gravity),
+    }
+    return finish(
+        Mechanism(
+            name=name,
+            links=tuple(links),
+            joints=joints,
+            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
+            outputs=(Output("slider_x", "slider6", OutputKind.POSITION_X, point="D"),),
+            gravity=(0.0, -gravity),
+            parameters=params,
+        )
+    )
 
 
 def watt_six_bar_slider_2(
@@ -350,9 +412,16 @@ def watt_six_bar_slider_2(
     lam = positive("linear_density", linear_density, "kg/m")
     if b <= a:
         raise ValueError(f"rod3_length must be > crank_length = {a} m (got {b} m)")
-    clr = ClearanceFactory(clearance_at, WATT_SLIDER_2_INFO.clearable, radial_clearance=radial_clearance,
-                           bearing_radius=bearing_radius, restitution=restitution, friction=friction,
-                           law=law, material=material)
+    clr = ClearanceFactory(
+        clearance_at,
+        WATT_SLIDER_2_INFO.clearable,
+        radial_clearance=radial_clearance,
+        bearing_radius=bearing_radius,
+        restitution=restitution,
+        friction=friction,
+        law=law,
+        material=material,
+    )
     o2, o6 = (0.0, 0.0), (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
     pa = polar(o2, a, start_angle)
     pb = line_circle(o2, (1.0, 0.0), pa, b, forward=True, what="rod 3 / slider 4")
@@ -376,12 +445,25 @@ def watt_six_bar_slider_2(
         clr.revolute("D", "coupler5", "D", "rocker6", "D"),
         clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
     )
-    params = {"crank_length": a, "rod3_length": b, "slider_pin_offset": list(off), "coupler5_length": f,
-              "rocker6_length": g, "rocker6_pivot": list(o6), "slider_mass": ms, "slider_inertia": js,
-              **_common(clr, crank_speed, start_angle, lam, gravity)}
-    return finish(Mechanism(
-        name=name, links=links, joints=joints,
-        drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-        outputs=(Output("rocker_angle", "rocker6", OutputKind.ANGLE),),
-        gravity=(0.0, -gravity), parameters=params,
-    ))
+    params = {
+        "crank_length": a,
+        "rod3_length": b,
+        "slider_pin_offset": list(off),
+        "coupler5_length": f,
+        "rocker6_length": g,
+        "rocker6_pivot": list(o6),
+        "slider_mass": ms,
+        "slider_inertia": js,
+        **_common(clr, crank_speed, start_angle, lam, gravity),
+    }
+    return finish(
+        Mechanism(
+            name=name,
+            links=links,
+            joints=joints,
+            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
+            outputs=(Output("rocker_angle", "rocker6", OutputKind.ANGLE),),
+            gravity=(0.0, -gravity),
+            parameters=params,
+        )
+    )

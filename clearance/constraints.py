@@ -17,6 +17,7 @@ from clearance.model import DriveKind, JointType, Mechanism
 
 __all__ = ["ConstraintSystem"]
 
+
 def _rot(th: np.ndarray | float) -> np.ndarray:
     c, s = np.cos(th), np.sin(th)
     return np.array([[c, -s], [s, c]])
@@ -85,9 +86,7 @@ class ConstraintSystem:
             which applies torque drives as torques, builds its system without them.
     """
 
-    def __init__(
-        self, mechanism: Mechanism, *, include_clearance: bool = True, include_drives: bool = True
-    ) -> None:
+    def __init__(self, mechanism: Mechanism, *, include_clearance: bool = True, include_drives: bool = True) -> None:
         self.mechanism = mechanism
         index = {lk.name: i for i, lk in enumerate(mechanism.moving_links)}
         index[mechanism.ground] = -1
@@ -143,10 +142,14 @@ class ConstraintSystem:
         pr, pa_, pb_ = self._pri[:3]
         dr, da_, db_ = self._drv_rows, self._drv_ia, self._drv_ib
         const = [
-            (rr * w + 3 * ra, 1.0), ((rr + 1) * w + 3 * ra + 1, 1.0),
-            (rr * w + 3 * rb, -1.0), ((rr + 1) * w + 3 * rb + 1, -1.0),
-            (pr * w + 3 * pa_ + 2, -1.0), (pr * w + 3 * pb_ + 2, 1.0),
-            (dr * w + 3 * db_ + 2, 1.0), (dr * w + 3 * da_ + 2, -1.0),
+            (rr * w + 3 * ra, 1.0),
+            ((rr + 1) * w + 3 * ra + 1, 1.0),
+            (rr * w + 3 * rb, -1.0),
+            ((rr + 1) * w + 3 * rb + 1, -1.0),
+            (pr * w + 3 * pa_ + 2, -1.0),
+            (pr * w + 3 * pb_ + 2, 1.0),
+            (dr * w + 3 * db_ + 2, 1.0),
+            (dr * w + 3 * da_ + 2, -1.0),
         ]
         self._jac_const_idx = np.concatenate([i for i, _ in const])
         self._jac_const_val = np.concatenate([np.full(len(i), v) for i, v in const])
@@ -167,10 +170,7 @@ class ConstraintSystem:
         out = np.empty(pose.shape[:-2] + (self.n_constraints,))
         rows, ia, ib, pa, pb, u, off = self._rev
         if len(rows):
-            res = (
-                pose[..., ia, :2] + _rotate(pose[..., ia, 2], pa)
-                - pose[..., ib, :2] - _rotate(pose[..., ib, 2], pb)
-            )
+            res = pose[..., ia, :2] + _rotate(pose[..., ia, 2], pa) - pose[..., ib, :2] - _rotate(pose[..., ib, 2], pb)
             out[..., rows], out[..., rows + 1] = res[..., 0], res[..., 1]
         rows, ia, ib, pa, pb, u, off = self._pri
         if len(rows):

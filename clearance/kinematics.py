@@ -87,9 +87,7 @@ def singularity_measure(mechanism: Mechanism, q: np.ndarray) -> np.ndarray:
     return ConstraintSystem(mechanism).singularity_measure(q)
 
 
-def _newton(
-    cs: ConstraintSystem, q: np.ndarray, t: float, tol: float, max_iter: int
-) -> tuple[np.ndarray, float, bool]:
+def _newton(cs: ConstraintSystem, q: np.ndarray, t: float, tol: float, max_iter: int) -> tuple[np.ndarray, float, bool]:
     """Damped Newton on Phi(q, t) = 0 from q. Returns (q, max |Phi|, converged)."""
     q = np.array(q, dtype=float)
     res = np.inf
@@ -184,13 +182,15 @@ def assemble(
     q, res, ok = _newton(cs, q0, t, tol, max_iter)
     if not ok:
         joint, gap = _widest_gap(cs, q, t)
-        where = (f"; the largest is at joint '{joint}', whose two sides stay {gap:.3g} m apart"
-                 if joint is not None else "")
+        where = (
+            f"; the largest is at joint '{joint}', whose two sides stay {gap:.3g} m apart" if joint is not None else ""
+        )
         raise AssemblyError(
             f"mechanism '{mechanism.name}' cannot be assembled at t = {t:g} s: loop-closure "
             f"residual {res:.3g} after {max_iter} Newton iterations{where} (check that the link "
             "lengths can close every loop at the drive start angles, and the pose guesses)",
-            joint=joint, gap=gap if joint is not None else None,
+            joint=joint,
+            gap=gap if joint is not None else None,
         )
     measure = float(cs.singularity_measure(q))
     if measure < singular_tol:
@@ -238,7 +238,12 @@ def _scaled_dev(cs: ConstraintSystem, a: np.ndarray, b: np.ndarray) -> np.ndarra
 
 
 def _track(
-    cs: ConstraintSystem, q: np.ndarray, t0: float, t1: float, max_step: float, tol: float,
+    cs: ConstraintSystem,
+    q: np.ndarray,
+    t0: float,
+    t1: float,
+    max_step: float,
+    tol: float,
     singular_tol: float,
 ) -> np.ndarray:
     """Follow the assembly branch from (q, t0) to t1 by continuation; return q at t1."""
@@ -341,8 +346,10 @@ def solve_kinematics(
         h = (times[iR] - times[iL])[:, None]
         s = np.where(h[:, 0] > 0, (times[rest] - times[iL]) / np.where(h[:, 0] > 0, h[:, 0], 1), 0)[:, None]
         guess = (
-            (2 * s**3 - 3 * s**2 + 1) * q[iL] + (s**3 - 2 * s**2 + s) * h * qd_tr[left]
-            + (-2 * s**3 + 3 * s**2) * q[iR] + (s**3 - s**2) * h * qd_tr[right]
+            (2 * s**3 - 3 * s**2 + 1) * q[iL]
+            + (s**3 - 2 * s**2 + s) * h * qd_tr[left]
+            + (-2 * s**3 + 3 * s**2) * q[iR]
+            + (s**3 - s**2) * h * qd_tr[right]
         )
         sol, ok = _newton_batch(cs, guess, times[rest], tol, 30)
         ok &= _scaled_dev(cs, sol, guess) <= 0.5 * max_step
@@ -365,9 +372,7 @@ def solve_kinematics(
     return KinematicsResult(times, q, qd, qdd, outputs, measure)
 
 
-def link_point_world(
-    mechanism: Mechanism, q: np.ndarray, link: str, point: tuple[float, float]
-) -> np.ndarray:
+def link_point_world(mechanism: Mechanism, q: np.ndarray, link: str, point: tuple[float, float]) -> np.ndarray:
     """World position of a point given in a link frame, for q of shape (..., nq): (..., 2)."""
     if link == mechanism.ground:
         return np.broadcast_to(np.asarray(point, dtype=float), q.shape[:-1] + (2,)).copy()
@@ -377,9 +382,7 @@ def link_point_world(
     return np.stack([x + c * point[0] - s * point[1], y + s * point[0] + c * point[1]], axis=-1)
 
 
-def output_kinematics(
-    mechanism: Mechanism, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray
-) -> dict[str, np.ndarray]:
+def output_kinematics(mechanism: Mechanism, q: np.ndarray, qd: np.ndarray, qdd: np.ndarray) -> dict[str, np.ndarray]:
     """Outputs (position, ``_vel``, ``_acc``) from coordinates of shape (n, nq)."""
     names = [lk.name for lk in mechanism.moving_links]
     out: dict[str, np.ndarray] = {}
@@ -464,7 +467,12 @@ def transmission_angle(mechanism: Mechanism, q: np.ndarray, spec: TransmissionAn
     else:
         i = [m.name for m in mechanism.moving_links].index(guide.link_a)
         th = q[..., 3 * i + 2]
-    ax = np.stack([np.cos(th) * guide.axis[0] - np.sin(th) * guide.axis[1],
-                   np.sin(th) * guide.axis[0] + np.cos(th) * guide.axis[1]], axis=-1)
+    ax = np.stack(
+        [
+            np.cos(th) * guide.axis[0] - np.sin(th) * guide.axis[1],
+            np.sin(th) * guide.axis[0] + np.cos(th) * guide.axis[1],
+        ],
+        axis=-1,
+    )
     # angle between the coupler and the guide normal = 90 deg - angle to the guide axis
     return np.arcsin(np.clip(np.abs(np.sum(u * ax, axis=-1)), 0.0, 1.0))

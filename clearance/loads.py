@@ -36,7 +36,9 @@ def generalized_inertial_forces(mechanism: Mechanism, q: np.ndarray, qd: np.ndar
     return out
 
 
-def joint_reaction_vectors(mechanism: Mechanism, times: np.ndarray) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
+def joint_reaction_vectors(
+    mechanism: Mechanism, times: np.ndarray
+) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Reaction forces of the ideal twin at every joint and drive.
 
     Solves Phi_q^T lambda = M qdd - Q at each time.

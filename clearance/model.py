@@ -26,6 +26,8 @@ from dataclasses import dataclass, field
 from types import MappingProxyType
 from typing import Any
 
+from clearance.checks import finite, positive
+
 __all__ = [
     "ContactLaw",
     "JointType",
@@ -78,32 +80,17 @@ class OutputKind(enum.Enum):
     ANGLE = "angle"
 
 
-def _finite(name: str, value: float) -> float:
-    if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number (got {value!r})")
-    return float(value)
-
-
-def _positive(name: str, value: float, unit: str) -> float:
-    v = _finite(name, value)
-    if v <= 0:
-        raise ValueError(f"{name} must be > 0 (got {value!r} {unit})")
-    return v
-
-
 def _point(name: str, value: Any) -> tuple[float, float]:
     try:
         x, y = value
     except (TypeError, ValueError):
         raise ValueError(f"{name} must be a pair (x, y) in metres (got {value!r})") from None
-    return (_finite(f"{name}[0]", x), _finite(f"{name}[1]", y))
+    return (finite(f"{name}[0]", x), finite(f"{name}[1]", y))
 
 
 def _name(field_name: str, value: Any) -> str:
     if not isinstance(value, str) or not value or not value.replace("_", "").replace("-", "").isalnum():
-        raise ValueError(
-            f"{field_name} must be a non-empty name of letters, digits, '_' or '-' (got {value!r})"
-        )
+        raise ValueError(f"{field_name} must be a non-empty name of letters, digits, '_' or '-' (got {value!r})")
     return value
 
 
@@ -120,8 +107,8 @@ class Material:
     poisson_ratio: float = 0.3
 
     def __post_init__(self) -> None:
-        _positive("youngs_modulus", self.youngs_modulus, "Pa")
-        nu = _finite("poisson_ratio", self.poisson_ratio)
+        positive("youngs_modulus", self.youngs_modulus, "Pa")
+        nu = finite("poisson_ratio", self.poisson_ratio)
         if not 0.0 <= nu < 0.5:
             raise ValueError(f"poisson_ratio must be in [0, 0.5) (got {self.poisson_ratio!r})")
 
@@ -158,16 +145,14 @@ class Clearance:
     law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH
 
     def __post_init__(self) -> None:
-        rb = _positive("bearing_radius", self.bearing_radius, "m")
-        c = _finite("radial_clearance", self.radial_clearance)
+        rb = positive("bearing_radius", self.bearing_radius, "m")
+        c = finite("radial_clearance", self.radial_clearance)
         if not 0.0 < c < rb:
-            raise ValueError(
-                f"radial_clearance must be > 0 and < bearing_radius = {rb} m (got {c!r} m)"
-            )
-        e = _finite("restitution", self.restitution)
+            raise ValueError(f"radial_clearance must be > 0 and < bearing_radius = {rb} m (got {c!r} m)")
+        e = finite("restitution", self.restitution)
         if not 0.0 < e <= 1.0:
             raise ValueError(f"restitution must be in (0, 1] (got {self.restitution!r})")
-        mu = _finite("friction", self.friction)
+        mu = finite("friction", self.friction)
         if mu < 0:
             raise ValueError(f"friction must be >= 0 (got {self.friction!r})")
         if not isinstance(self.law, ContactLaw):
@@ -204,30 +189,25 @@ class Link:
 
     def __post_init__(self) -> None:
         _name("Link.name", self.name)
-        m = _finite(f"link '{self.name}' mass", self.mass)
-        j = _finite(f"link '{self.name}' inertia", self.inertia)
+        m = finite(f"link '{self.name}' mass", self.mass)
+        j = finite(f"link '{self.name}' inertia", self.inertia)
         if m < 0 or j < 0:
             raise ValueError(
-                f"link '{self.name}': mass and inertia must be >= 0 (got {self.mass!r} kg, "
-                f"{self.inertia!r} kg m^2)"
+                f"link '{self.name}': mass and inertia must be >= 0 (got {self.mass!r} kg, {self.inertia!r} kg m^2)"
             )
         object.__setattr__(self, "com", _point(f"link '{self.name}' com", self.com))
         pts = {}
         for k, v in dict(self.points).items():
-            pts[_name(f"link '{self.name}' point name", k)] = _point(
-                f"link '{self.name}' point '{k}'", v
-            )
+            pts[_name(f"link '{self.name}' point name", k)] = _point(f"link '{self.name}' point '{k}'", v)
         object.__setattr__(self, "points", MappingProxyType(pts))
         try:
             x, y, th = self.pose_guess
         except (TypeError, ValueError):
-            raise ValueError(
-                f"link '{self.name}' pose_guess must be (x, y, theta) (got {self.pose_guess!r})"
-            ) from None
+            raise ValueError(f"link '{self.name}' pose_guess must be (x, y, theta) (got {self.pose_guess!r})") from None
         object.__setattr__(
             self,
             "pose_guess",
-            tuple(_finite(f"link '{self.name}' pose_guess", v) for v in (x, y, th)),
+            tuple(finite(f"link '{self.name}' pose_guess", v) for v in (x, y, th)),
         )
 
     def point(self, name: str) -> tuple[float, float]:
@@ -235,9 +215,7 @@ class Link:
         try:
             return self.points[name]
         except KeyError:
-            raise KeyError(
-                f"link '{self.name}' has no point '{name}' (it has: {sorted(self.points)})"
-            ) from None
+            raise KeyError(f"link '{self.name}' has no point '{name}' (it has: {sorted(self.points)})") from None
 
 
 @dataclass(frozen=True)
@@ -278,13 +256,10 @@ class Joint:
         if self.clearance is not None:
             if self.kind is not JointType.REVOLUTE:
                 raise ValueError(
-                    f"joint '{self.name}': clearance is only supported on revolute joints "
-                    f"(got kind={self.kind.value})"
+                    f"joint '{self.name}': clearance is only supported on revolute joints (got kind={self.kind.value})"
                 )
             if not isinstance(self.clearance, Clearance):
-                raise ValueError(
-                    f"joint '{self.name}' clearance must be a Clearance (got {self.clearance!r})"
-                )
+                raise ValueError(f"joint '{self.name}' clearance must be a Clearance (got {self.clearance!r})")
             jl = self.clearance.journal_link
             if jl is not None and jl not in (self.link_a, self.link_b):
                 raise ValueError(
@@ -309,14 +284,14 @@ class MotionLaw:
     period: float | None = None
 
     def __post_init__(self) -> None:
-        _finite("MotionLaw.speed", self.speed)
+        finite("MotionLaw.speed", self.speed)
         hs = tuple(_point(f"MotionLaw.harmonics[{i}]", h) for i, h in enumerate(self.harmonics))
         object.__setattr__(self, "harmonics", hs)
         if self.period is None:
             if self.speed == 0:
                 raise ValueError("MotionLaw.period must be given when speed is 0")
         else:
-            _positive("MotionLaw.period", self.period, "s")
+            positive("MotionLaw.period", self.period, "s")
 
     @property
     def fundamental(self) -> float:
@@ -384,9 +359,9 @@ class Drive:
         _name(f"drive '{self.name}' joint", self.joint)
         if not isinstance(self.kind, DriveKind):
             raise ValueError(f"drive '{self.name}' kind must be a DriveKind (got {self.kind!r})")
-        _finite(f"drive '{self.name}' speed", self.speed)
-        _finite(f"drive '{self.name}' start_angle", self.start_angle)
-        _finite(f"drive '{self.name}' torque", self.torque)
+        finite(f"drive '{self.name}' speed", self.speed)
+        finite(f"drive '{self.name}' start_angle", self.start_angle)
+        finite(f"drive '{self.name}' torque", self.torque)
         if self.kind is DriveKind.CONSTANT_SPEED and self.speed == 0:
             raise ValueError(f"drive '{self.name}' speed must be non-zero for a constant-speed drive")
         if self.kind is DriveKind.MOTION_LAW and not isinstance(self.motion, MotionLaw):
@@ -509,8 +484,7 @@ class Mechanism:
                 ln, pn = getattr(j, f"link_{side}"), getattr(j, f"point_{side}")
                 if ln not in links:
                     raise ValueError(
-                        f"joint '{j.name}' link_{side} = '{ln}' is not a link of the mechanism "
-                        f"(links: {sorted(links)})"
+                        f"joint '{j.name}' link_{side} = '{ln}' is not a link of the mechanism (links: {sorted(links)})"
                     )
                 if pn not in links[ln].points:
                     raise ValueError(
@@ -535,9 +509,7 @@ class Mechanism:
             if o.link not in links:
                 raise ValueError(f"output '{o.name}' link '{o.link}' is not a link of the mechanism")
             if o.point is not None and o.point not in links[o.link].points:
-                raise ValueError(
-                    f"output '{o.name}' point '{o.point}' is not a point of link '{o.link}'"
-                )
+                raise ValueError(f"output '{o.name}' point '{o.point}' is not a point of link '{o.link}'")
         # connectivity
         adj: dict[str, set[str]] = {n: set() for n in links}
         for j in self.joints:

@@ -83,9 +83,7 @@ class ModelOptions:
                 try:
                     object.__setattr__(self, name, GeomType(v))
                 except ValueError:
-                    raise ValueError(
-                        f"{name} must be one of {[g.value for g in GeomType]} (got {v!r})"
-                    ) from None
+                    raise ValueError(f"{name} must be one of {[g.value for g in GeomType]} (got {v!r})") from None
         if self.journal_geom is GeomType.BOX:
             raise ValueError("journal_geom must be sphere, capsule or cylinder (got 'box')")
         if not isinstance(self.contact_mode, ContactMode):
@@ -93,16 +91,14 @@ class ModelOptions:
                 object.__setattr__(self, "contact_mode", ContactMode(self.contact_mode))
             except ValueError:
                 raise ValueError(
-                    f"contact_mode must be one of {[c.value for c in ContactMode]} "
-                    f"(got {self.contact_mode!r})"
+                    f"contact_mode must be one of {[c.value for c in ContactMode]} (got {self.contact_mode!r})"
                 ) from None
         h = self.timestep
         if not isinstance(h, (int, float)) or not math.isfinite(h) or not 0 < h <= 1e-2:
             raise ValueError(f"timestep must be in (0, 0.01] s (got {h!r})")
         if self.integrator not in ("implicitfast", "euler", "implicit", "rk4"):
             raise ValueError(
-                "integrator must be one of 'implicitfast', 'euler', 'implicit', 'rk4' "
-                f"(got {self.integrator!r})"
+                f"integrator must be one of 'implicitfast', 'euler', 'implicit', 'rk4' (got {self.integrator!r})"
             )
         if not 0 < self.ripple_limit < 1:
             raise ValueError(f"ripple_limit must be in (0, 1) (got {self.ripple_limit!r})")
@@ -110,8 +106,7 @@ class ModelOptions:
             raise ValueError(f"impedance must be in (0, 0.5) (got {self.impedance!r})")
         if self.closure_timeconst is not None and not self.closure_timeconst >= 2 * h:
             raise ValueError(
-                f"closure_timeconst must be >= 2 * timestep = {2 * h:g} s "
-                f"(got {self.closure_timeconst!r})"
+                f"closure_timeconst must be >= 2 * timestep = {2 * h:g} s (got {self.closure_timeconst!r})"
             )
 
 

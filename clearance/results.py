@@ -220,9 +220,7 @@ class SimulationResult:
             return cls(
                 times=z["times"],
                 outputs={k: z[f"output/{k}"] for k in out_names},
-                joints={
-                    j: JointResult(*(z[f"joint/{j}/{f}"] for f in _JOINT_FIELDS)) for j in joint_names
-                },
+                joints={j: JointResult(*(z[f"joint/{j}/{f}"] for f in _JOINT_FIELDS)) for j in joint_names},
                 drive_angle=z["drive_angle"],
                 drive_speed=z["drive_speed"],
                 drive_torque=z["drive_torque"],

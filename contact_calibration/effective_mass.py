@@ -31,10 +31,10 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from clearance.mjcf.spec import BuiltModel
 
 from clearance.kinematics import solve_kinematics
 from clearance.loads import joint_reaction_vectors
+from clearance.mjcf.spec import BuiltModel
 from clearance.model import DriveKind, Mechanism
 
 __all__ = ["EffectiveMass", "LIGHT_LOAD", "cycle_effective_mass", "normal_effective_mass"]
@@ -97,15 +97,13 @@ def _set_pose(model: mujoco.MjModel, data: mujoco.MjData, bids: list[int], targe
     return res
 
 
-def _constraint_rows(model: mujoco.MjModel, data: mujoco.MjData, mechanism: Mechanism,
-                     lock_drives: bool) -> np.ndarray:
+def _constraint_rows(model: mujoco.MjModel, data: mujoco.MjData, mechanism: Mechanism, lock_drives: bool) -> np.ndarray:
     rows = []
     eq = data.efc_type[: data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY
     if np.any(eq):
         jac = np.zeros((data.nefc, model.nv))
         if mujoco.mj_isSparse(model):
-            mujoco.mju_sparse2dense(jac, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr,
-                                    data.efc_J_colind)
+            mujoco.mju_sparse2dense(jac, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr, data.efc_J_colind)
         else:
             jac = data.efc_J[: data.nefc * model.nv].reshape(data.nefc, model.nv)
         rows += list(jac[eq])
@@ -137,8 +135,7 @@ def _mobility(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndar
     return jrel @ w @ jrel.T
 
 
-def _bearing_mass(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndarray,
-                  n_dir: int) -> float:
+def _bearing_mass(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndarray, n_dir: int) -> float:
     a = _mobility(model, data, joint, g)
     ang = np.linspace(0, np.pi, n_dir, endpoint=False)
     n = np.stack([np.cos(ang), np.sin(ang)], axis=1)
@@ -147,8 +144,13 @@ def _bearing_mass(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.
 
 
 def normal_effective_mass(
-    model: mujoco.MjModel, data: mujoco.MjData, mechanism: Mechanism, joint: str,
-    normal: np.ndarray, *, lock_velocity_drives: bool = True,
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    mechanism: Mechanism,
+    joint: str,
+    normal: np.ndarray,
+    *,
+    lock_velocity_drives: bool = True,
 ) -> float:
     """Effective mass a journal impact sees along one normal, at the data's current pose.
 
@@ -182,8 +184,14 @@ def normal_effective_mass(
 
 
 def cycle_effective_mass(
-    model: mujoco.MjModel, built: BuiltModel, mechanism: Mechanism, *, n_poses: int = 36,
-    n_dir: int = 36, lock_velocity_drives: bool = True, along_load: bool = True,
+    model: mujoco.MjModel,
+    built: BuiltModel,
+    mechanism: Mechanism,
+    *,
+    n_poses: int = 36,
+    n_dir: int = 36,
+    lock_velocity_drives: bool = True,
+    along_load: bool = True,
 ) -> dict[str, EffectiveMass]:
     """Effective mass at every clearance joint over one drive period of the ideal cycle.
 
@@ -229,6 +237,4 @@ def cycle_effective_mass(
                 out[j][i] = 1.0 / max(float(n @ _mobility(model, data, j, g) @ n), 1e-300)
             else:
                 out[j][i] = _bearing_mass(model, data, j, g, n_dir)
-    return {j: EffectiveMass(float(np.median(v)), float(v.min()), float(v.max()), times, v)
-            for j, v in out.items()}
-
+    return {j: EffectiveMass(float(np.median(v)), float(v.min()), float(v.max()), times, v) for j, v in out.items()}

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
+
 from clearance.contact_calibration.laws import (
     MIN_APPROACH_SPEED,
     bearing_stiffness,
@@ -50,11 +51,21 @@ from clearance.contact_calibration.scene_impact import (
 )
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.probe import ring_scene
-
 from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters, ModelOptions
 
-__all__ = ["ExactLNContact", "crossing_speed", "impose_exact_ln", "step_exact_ln", "ExactLNRun", "ExactLNStepError", "exact_ln_impact", "polygon_margin", "ExactLNCost", "exact_ln_cost"]
+__all__ = [
+    "ExactLNContact",
+    "crossing_speed",
+    "impose_exact_ln",
+    "step_exact_ln",
+    "ExactLNRun",
+    "ExactLNStepError",
+    "exact_ln_impact",
+    "polygon_margin",
+    "ExactLNCost",
+    "exact_ln_cost",
+]
 
 
 def polygon_margin(ring: RingGeometry) -> float:
@@ -102,15 +113,21 @@ class ExactLNContact:
         ValueError: the law is IMPACT, or a pair has friction (condim > 1).
     """
 
-    def __init__(self, model: mujoco.MjModel, clearance: Clearance, ring: RingGeometry, *,
-                 journal_geom: str, bearing_site: str | None = None) -> None:
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        clearance: Clearance,
+        ring: RingGeometry,
+        *,
+        journal_geom: str,
+        bearing_site: str | None = None,
+    ) -> None:
         if clearance.law is ContactLaw.IMPACT:
             raise ValueError("exact-LN mode needs a law with a restitution (not IMPACT)")
         self.jg = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_GEOM, journal_geom)
         if self.jg < 0:
             raise ValueError(f"no geom named {journal_geom!r}")
-        self.site = -1 if bearing_site is None else mujoco.mj_name2id(
-            model, mujoco.mjtObj.mjOBJ_SITE, bearing_site)
+        self.site = -1 if bearing_site is None else mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, bearing_site)
         pairs = np.flatnonzero((model.pair_geom1 == self.jg) | (model.pair_geom2 == self.jg))
         if np.any(model.pair_dim[pairs] != 1):
             raise ValueError("exact-LN mode supports frictionless pairs (condim 1) only")
@@ -196,14 +213,12 @@ def _dense_jacobian(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
     nv = model.nv
     if mujoco.mj_isSparse(model):
         jac = np.zeros((data.nefc, nv))
-        mujoco.mju_sparse2dense(jac, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr,
-                                data.efc_J_colind)
+        mujoco.mju_sparse2dense(jac, data.efc_J, data.efc_J_rownnz, data.efc_J_rowadr, data.efc_J_colind)
         return jac
     return data.efc_J[: data.nefc * nv].reshape(data.nefc, nv)
 
 
-def impose_exact_ln(model: mujoco.MjModel, data: mujoco.MjData,
-                    contacts: list[ExactLNContact]) -> np.ndarray:
+def impose_exact_ln(model: mujoco.MjModel, data: mujoco.MjData, contacts: list[ExactLNContact]) -> np.ndarray:
     """Set ``efc_aref`` of every exact-LN joint's rows; call between mj_step1 and mj_step2.
 
     With c the contact rows (target forces f*) and e the equality rows (always active,
@@ -280,8 +295,12 @@ class ExactLNStepError(RuntimeError):
 
 
 def step_exact_ln(
-    model: mujoco.MjModel, data: mujoco.MjData, contacts: list[ExactLNContact], nstep: int,
-    *, ctrl: np.ndarray | None = None,
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    contacts: list[ExactLNContact],
+    nstep: int,
+    *,
+    ctrl: np.ndarray | None = None,
 ) -> ExactLNRun:
     """Step ``nstep`` times with exact-LN contact (the Python counterpart of rollout).
 
@@ -317,15 +336,23 @@ def step_exact_ln(
         pen[i] = [c.last_penetration for c in contacts]
         mujoco.mj_step2(model, data)
         qpos[i], qvel[i], sens[i] = data.qpos, data.qvel, data.sensordata
-        fired = [mujoco.mjtWarning(k).name for k in range(mujoco.mjtWarning.mjNWARNING.value)
-                 if data.warning[k].number] if int(data.warning.number.sum()) > warn0 else []
+        fired = (
+            [mujoco.mjtWarning(k).name for k in range(mujoco.mjtWarning.mjNWARNING.value) if data.warning[k].number]
+            if int(data.warning.number.sum()) > warn0
+            else []
+        )
         finite = bool(np.all(np.isfinite(data.qvel)) and np.all(np.isfinite(data.sensordata)))
         if fired or not finite:
             reason = (f"MuJoCo raised warnings {fired}" if fired else "") + (
-                (" and " if fired else "") + "the state became non-finite (NaN or Inf)" if not finite else "")
+                (" and " if fired else "") + "the state became non-finite (NaN or Inf)" if not finite else ""
+            )
             partial = ExactLNRun(qpos[:i], qvel[:i], sens[:i], force[:i], pen[:i])
-            raise ExactLNStepError(f"exact-LN run failed at step {i} (t = {data.time:.6g} s): {reason}",
-                                   step=i, reason=reason, partial=partial)
+            raise ExactLNStepError(
+                f"exact-LN run failed at step {i} (t = {data.time:.6g} s): {reason}",
+                step=i,
+                reason=reason,
+                partial=partial,
+            )
     return ExactLNRun(qpos, qvel, sens, force, pen)
 
 
@@ -350,8 +377,14 @@ def _scene(clearance: Clearance, ring: RingGeometry, options: ModelOptions, mass
 
 
 def exact_ln_impact(
-    clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
-    speed: float, direction: float = 0.0, max_steps: int | None = None,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    *,
+    mass: float,
+    speed: float,
+    direction: float = 0.0,
+    max_steps: int | None = None,
 ) -> SceneImpact:
     """A radial impact in the one-bearing scene with exact-LN contact.
 
@@ -401,15 +434,27 @@ def exact_ln_impact(
     t_on = (on - 1 + _crossing(dl[on - 1], dl[on])) * h
     t_off = (off - 1 + _crossing(dl[off - 1], dl[off])) * h
     return SceneImpact(
-        speed=float(speed), direction=float(direction), times=np.arange(len(dl)) * h - t_on,
-        penetration=dl, force=fl, peak_force=_peak(fl)[0], max_penetration=_peak(dl)[0],
-        duration=t_off - t_on, restitution=-vel[-1] / speed,
+        speed=float(speed),
+        direction=float(direction),
+        times=np.arange(len(dl)) * h - t_on,
+        penetration=dl,
+        force=fl,
+        peak_force=_peak(fl)[0],
+        max_penetration=_peak(dl)[0],
+        duration=t_off - t_on,
+        restitution=-vel[-1] / speed,
     )
 
 
 def exact_ln_cost(
-    clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
-    params: ContactParameters, load: float = 1000.0, nstep: int = 20000,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    *,
+    mass: float,
+    params: ContactParameters,
+    load: float = 1000.0,
+    nstep: int = 20000,
 ) -> ExactLNCost:
     """Measure steps/s of the exact-LN loop and of `mujoco.rollout` on the scene.
 

@@ -32,6 +32,8 @@ from dataclasses import asdict, dataclass, field
 
 import mujoco
 import numpy as np
+from scipy.optimize import least_squares
+
 from clearance.contact_calibration.impact import ImpactResult, law_impact
 from clearance.contact_calibration.laws import bearing_stiffness
 from clearance.contact_calibration.nominal import nominal_parameters
@@ -42,8 +44,6 @@ from clearance.contact_calibration.scene_impact import (
 )
 from clearance.mjcf.bearing import RingGeometry, ring_damping_coefficient, ring_force
 from clearance.mjcf.probe import ring_scene
-from scipy.optimize import least_squares
-
 from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters, ModelOptions
 
@@ -97,10 +97,12 @@ class SpeedRow:
 
     def meets_goals(self) -> bool:
         """All four worst-direction errors within `GOALS`."""
-        return (abs(self.peak_force_worst) <= GOALS["peak_force"]
-                and abs(self.max_penetration_worst) <= GOALS["max_penetration"]
-                and abs(self.duration_worst) <= GOALS["duration"]
-                and abs(self.restitution_worst) <= GOALS["restitution"])
+        return (
+            abs(self.peak_force_worst) <= GOALS["peak_force"]
+            and abs(self.max_penetration_worst) <= GOALS["max_penetration"]
+            and abs(self.duration_worst) <= GOALS["duration"]
+            and abs(self.restitution_worst) <= GOALS["restitution"]
+        )
 
 
 @dataclass(frozen=True)
@@ -168,13 +170,16 @@ class CalibrationResult:
         return cls(
             parameters=ContactParameters(**d["parameters"]),
             initial=ContactParameters(**d["initial"]),
-            mass=float(d["mass"]), mass_range=tuple(float(x) for x in d["mass_range"]),
+            mass=float(d["mass"]),
+            mass_range=tuple(float(x) for x in d["mass_range"]),
             timestep=float(d["timestep"]),
             speeds=tuple(float(x) for x in d["speeds"]),
             directions=tuple(float(x) for x in d["directions"]),
             rows=tuple(SpeedRow(**r) for r in d["rows"]),
             stability=Stability(**d["stability"]),
-            nfev=int(d["nfev"]), wall_time=float(d["wall_time"]), meta=dict(d["meta"]),
+            nfev=int(d["nfev"]),
+            wall_time=float(d["wall_time"]),
+            meta=dict(d["meta"]),
         )
 
 
@@ -197,29 +202,44 @@ def reference_impacts(clearance: Clearance, *, mass: float, speeds: np.ndarray) 
     if clearance.law is ContactLaw.IMPACT:
         raise ValueError("calibration against the IMPACT law is not supported (no c_max/d_max in Clearance)")
     k = bearing_stiffness(clearance)
-    return [law_impact(clearance.law, mass=mass, speed=float(v), stiffness=k,
-                       restitution=clearance.restitution, n_samples=400) for v in speeds]
+    return [
+        law_impact(
+            clearance.law, mass=mass, speed=float(v), stiffness=k, restitution=clearance.restitution, n_samples=400
+        )
+        for v in speeds
+    ]
 
 
 def _nstep(refs: list[ImpactResult], h: float) -> int:
     return int(math.ceil(2.5 * max(r.duration for r in refs) / h)) + 8
 
 
-def _scene(ring: RingGeometry, options: ModelOptions, params: ContactParameters, mass: float,
-           friction: float) -> mujoco.MjModel:
+def _scene(
+    ring: RingGeometry, options: ModelOptions, params: ContactParameters, mass: float, friction: float
+) -> mujoco.MjModel:
     return ring_scene(ring, options, params, mass=mass, friction=friction)
 
 
 def _errors(imp: SceneImpact, ref: ImpactResult) -> np.ndarray:
-    return np.array([imp.peak_force / ref.peak_force - 1.0,
-                     imp.max_penetration / ref.max_penetration - 1.0,
-                     imp.duration / ref.duration - 1.0,
-                     imp.restitution - ref.restitution])
+    return np.array(
+        [
+            imp.peak_force / ref.peak_force - 1.0,
+            imp.max_penetration / ref.max_penetration - 1.0,
+            imp.duration / ref.duration - 1.0,
+            imp.restitution - ref.restitution,
+        ]
+    )
 
 
 def evaluate(
-    clearance: Clearance, ring: RingGeometry, options: ModelOptions, params: ContactParameters,
-    *, mass: float, speeds: np.ndarray, directions: np.ndarray | None = None,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    params: ContactParameters,
+    *,
+    mass: float,
+    speeds: np.ndarray,
+    directions: np.ndarray | None = None,
     refs: list[ImpactResult] | None = None,
 ) -> tuple[np.ndarray, list[list[SceneImpact]], list[ImpactResult]]:
     """Run the MuJoCo impacts with ``params`` and compare them with the reference.
@@ -243,8 +263,9 @@ def evaluate(
         directions = np.array(DEFAULT_DIRECTIONS) * 2 * math.pi / ring.segments
     refs = refs or reference_impacts(clearance, mass=mass, speeds=speeds)
     model = _scene(ring, options, params, mass, clearance.friction)
-    imps = scene_impacts(model, ring, mass=mass, speeds=speeds, directions=np.asarray(directions),
-                         nstep=_nstep(refs, options.timestep))
+    imps = scene_impacts(
+        model, ring, mass=mass, speeds=speeds, directions=np.asarray(directions), nstep=_nstep(refs, options.timestep)
+    )
     err = np.array([[_errors(imp, ref) for imp in row] for row, ref in zip(imps, refs)])
     return err, imps, refs
 
@@ -254,25 +275,43 @@ def _rows(speeds: np.ndarray, err: np.ndarray, refs: list[ImpactResult]) -> tupl
     for v, e, r in zip(speeds, err, refs):
         mean = e.mean(axis=0)
         worst = e[np.argmax(np.abs(e), axis=0), np.arange(4)]
-        out.append(SpeedRow(float(v), r.peak_force, r.max_penetration, r.duration, r.restitution,
-                            *(float(x) for pair in zip(mean, worst) for x in pair)))
+        out.append(
+            SpeedRow(
+                float(v),
+                r.peak_force,
+                r.max_penetration,
+                r.duration,
+                r.restitution,
+                *(float(x) for pair in zip(mean, worst) for x in pair),
+            )
+        )
     return tuple(out)
 
 
 def accuracy_rows(
-    clearance: Clearance, ring: RingGeometry, options: ModelOptions, params: ContactParameters,
-    *, mass: float, speeds: np.ndarray, directions: np.ndarray | None = None,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    params: ContactParameters,
+    *,
+    mass: float,
+    speeds: np.ndarray,
+    directions: np.ndarray | None = None,
 ) -> tuple[SpeedRow, ...]:
     """Accuracy of ``params`` against the reference at any ``speeds`` [m/s] (see `evaluate`)."""
     speeds = np.asarray(speeds, dtype=float)
-    err, _, refs = evaluate(clearance, ring, options, params, mass=mass, speeds=speeds,
-                            directions=directions)
+    err, _, refs = evaluate(clearance, ring, options, params, mass=mass, speeds=speeds, directions=directions)
     return _rows(speeds, err, refs)
 
 
 def check_stability(
-    ring: RingGeometry, params: ContactParameters, *, mass: float, timestep: float,
-    max_penetration: float, raise_error: bool = True,
+    ring: RingGeometry,
+    params: ContactParameters,
+    *,
+    mass: float,
+    timestep: float,
+    max_penetration: float,
+    raise_error: bool = True,
 ) -> Stability:
     """Check that the emitted direct-mode contact is stable at ``timestep``.
 
@@ -323,9 +362,15 @@ def check_stability(
 
 
 def fit_contact(
-    clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
-    speeds: np.ndarray, mass_range: tuple[float, float] | None = None,
-    max_penetration: float | None = None, directions: np.ndarray | None = None,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    *,
+    mass: float,
+    speeds: np.ndarray,
+    mass_range: tuple[float, float] | None = None,
+    max_penetration: float | None = None,
+    directions: np.ndarray | None = None,
     max_nfev: int = 60,
 ) -> CalibrationResult:
     """Fit per-row stiffness and damping to the clearance's law over ``speeds``.
@@ -360,10 +405,10 @@ def fit_contact(
         directions = np.array(DEFAULT_DIRECTIONS) * 2 * math.pi / ring.segments
     directions = np.asarray(directions, dtype=float)
     refs = reference_impacts(clearance, mass=mass, speeds=speeds)
-    start = nominal_parameters(clearance, ring, effective_mass=mass,
-                               impact_speed=float(np.sqrt(speeds[0] * speeds[-1])))
-    scale = np.array([GOALS["peak_force"], GOALS["max_penetration"], GOALS["duration"],
-                      GOALS["restitution"]])
+    start = nominal_parameters(
+        clearance, ring, effective_mass=mass, impact_speed=float(np.sqrt(speeds[0] * speeds[-1]))
+    )
+    scale = np.array([GOALS["peak_force"], GOALS["max_penetration"], GOALS["duration"], GOALS["restitution"]])
     nfev = 0
 
     def residuals(x: np.ndarray) -> np.ndarray:
@@ -371,28 +416,40 @@ def fit_contact(
         nfev += 1
         p = ContactParameters(float(np.exp(x[0])), float(np.exp(x[1])), "fit")
         try:
-            err, _, _ = evaluate(clearance, ring, options, p, mass=mass, speeds=speeds,
-                                 directions=directions, refs=refs)
+            err, _, _ = evaluate(
+                clearance, ring, options, p, mass=mass, speeds=speeds, directions=directions, refs=refs
+            )
         except RuntimeError:
             return np.full(len(speeds) * len(directions) * 4, 1e3)  # diverged/failed: far off
         return (err / scale).ravel()
 
     x0 = np.log([start.stiffness, max(start.damping, 1e-9 * start.stiffness)])
-    sol = least_squares(residuals, x0, method="trf", diff_step=1e-3, x_scale=1.0,
-                        max_nfev=max_nfev, xtol=1e-6, ftol=1e-8)
+    sol = least_squares(
+        residuals, x0, method="trf", diff_step=1e-3, x_scale=1.0, max_nfev=max_nfev, xtol=1e-6, ftol=1e-8
+    )
     params = ContactParameters(float(np.exp(sol.x[0])), float(np.exp(sol.x[1])), "calibrated")
-    err, _, _ = evaluate(clearance, ring, options, params, mass=mass, speeds=speeds,
-                         directions=directions, refs=refs)
+    err, _, _ = evaluate(clearance, ring, options, params, mass=mass, speeds=speeds, directions=directions, refs=refs)
     dmax = max_penetration if max_penetration is not None else 4 * refs[-1].max_penetration
     stab = check_stability(ring, params, mass=mass, timestep=options.timestep, max_penetration=dmax)
     return CalibrationResult(
-        parameters=params, initial=start, mass=float(mass),
+        parameters=params,
+        initial=start,
+        mass=float(mass),
         mass_range=tuple(mass_range) if mass_range else (float(mass), float(mass)),
-        timestep=options.timestep, speeds=tuple(float(v) for v in speeds),
-        directions=tuple(float(d) for d in directions), rows=_rows(speeds, err, refs),
-        stability=stab, nfev=nfev, wall_time=time.perf_counter() - t0,
-        meta={"mujoco": mujoco.__version__, "law": clearance.law.value,
-              "solref_mode": "direct (-k*A_hat, -b*A_hat), solimp unchanged",
-              "impedance": options.impedance, "fit_version": FIT_VERSION,
-              "residual_scale": GOALS, "optimizer": f"least_squares: {sol.message}"},
+        timestep=options.timestep,
+        speeds=tuple(float(v) for v in speeds),
+        directions=tuple(float(d) for d in directions),
+        rows=_rows(speeds, err, refs),
+        stability=stab,
+        nfev=nfev,
+        wall_time=time.perf_counter() - t0,
+        meta={
+            "mujoco": mujoco.__version__,
+            "law": clearance.law.value,
+            "solref_mode": "direct (-k*A_hat, -b*A_hat), solimp unchanged",
+            "impedance": options.impedance,
+            "fit_version": FIT_VERSION,
+            "residual_scale": GOALS,
+            "optimizer": f"least_squares: {sol.message}",
+        },
     )

@@ -47,11 +47,12 @@ from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
-from clearance.contact_calibration import laws
 from scipy.integrate import DenseOutput, OdeSolution, solve_ivp
 from scipy.optimize import minimize_scalar
 from scipy.special import beta
 
+from clearance.checks import positive
+from clearance.contact_calibration import laws
 from clearance.model import Clearance, ContactLaw
 
 __all__ = [
@@ -124,19 +125,7 @@ class HertzImpact:
     duration: float
 
 
-def _positive(name: str, value: Any, unit: str) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a positive finite number (got {value!r})") from None
-    if not math.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} must be positive and finite (got {value!r} {unit})")
-    return v
-
-
-def hertz_impact(
-    *, mass: float, speed: float, stiffness: float, exponent: float = 1.5
-) -> HertzImpact:
+def hertz_impact(*, mass: float, speed: float, stiffness: float, exponent: float = 1.5) -> HertzImpact:
     """Closed-form impact of a point mass on a wall under F = K δⁿ (no dissipation).
 
     Energy gives δ_max = ((n + 1) m v² / (2K))^(1/(n+1)); for n = 1.5 that is the standard
@@ -156,10 +145,10 @@ def hertz_impact(
     Raises:
         ValueError: if an argument is not positive and finite.
     """
-    m = _positive("mass", mass, "kg")
-    v = _positive("speed", speed, "m/s")
-    k = _positive("stiffness", stiffness, "N/m^n")
-    n = _positive("exponent", exponent, "")
+    m = positive("mass", mass, "kg")
+    v = positive("speed", speed, "m/s")
+    k = positive("stiffness", stiffness, "N/m^n")
+    n = positive("exponent", exponent, "")
     dmax = ((n + 1) * m * v * v / (2 * k)) ** (1 / (n + 1))
     duration = 2 * dmax / v * beta(1 / (n + 1), 0.5) / (n + 1)
     return HertzImpact(dmax, k * dmax**n, float(duration))
@@ -233,18 +222,24 @@ def _reengagement(force: ForceLaw, delta: float, rate: float, v: float) -> float
 
 
 def _simulate(
-    force: ForceLaw, mass: Any, speed: Any, tangential_speed: float | None,
-    friction: float, v0: float, v1: float, rtol: float, atol: float | None,
-    max_duration: float | None, n_samples: int,
+    force: ForceLaw,
+    mass: Any,
+    speed: Any,
+    tangential_speed: float | None,
+    friction: float,
+    v0: float,
+    v1: float,
+    rtol: float,
+    atol: float | None,
+    max_duration: float | None,
+    n_samples: int,
 ) -> ImpactResult:
     if not callable(force):
-        raise ValueError(
-            f"force must be callable as force(delta, delta_dot, approach_speed) (got {force!r})"
-        )
-    m = _positive("mass", mass, "kg")
-    v = _positive("speed", speed, "m/s")
-    rtol = _positive("rtol", rtol, "")
-    atol = rtol if atol is None else _positive("atol", atol, "(scaled state)")
+        raise ValueError(f"force must be callable as force(delta, delta_dot, approach_speed) (got {force!r})")
+    m = positive("mass", mass, "kg")
+    v = positive("speed", speed, "m/s")
+    rtol = positive("rtol", rtol, "")
+    atol = rtol if atol is None else positive("atol", atol, "(scaled state)")
     if not isinstance(n_samples, (int, np.integer)) or isinstance(n_samples, bool) or n_samples < 2:
         raise ValueError(f"n_samples must be an integer >= 2 (got {n_samples!r})")
     oblique = tangential_speed is not None
@@ -257,7 +252,7 @@ def _simulate(
     d_s = _penetration_scale(force, m, v)
     t_s = d_s / v
     gain = t_s / (m * v)  # force [N] -> d(δ̇/v)/d(t/t_s)
-    t_end = 1e3 if max_duration is None else _positive("max_duration", max_duration, "s") / t_s
+    t_end = 1e3 if max_duration is None else positive("max_duration", max_duration, "s") / t_s
 
     def rhs(_: float, y: np.ndarray) -> list[float]:
         f = float(force(d_s * y[0], v * y[1], v))
@@ -286,14 +281,21 @@ def _simulate(
 
     def no_separation(message: str) -> RuntimeError:
         return RuntimeError(
-            f"no separation within {t_end * t_s:.3g} s ({message}); raise max_duration for "
-            "a strongly damped law"
+            f"no separation within {t_end * t_s:.3g} s ({message}); raise max_duration for a strongly damped law"
         )
 
     def integrate(t0: float, t1: float, y0: np.ndarray, first_step: float | None) -> Any:
         return solve_ivp(
-            rhs, (t0, t1), y0, method="DOP853", rtol=rtol, atol=atol, dense_output=True,
-            events=(separation, turning, released), max_step=_MAX_STEP, first_step=first_step,
+            rhs,
+            (t0, t1),
+            y0,
+            method="DOP853",
+            rtol=rtol,
+            atol=atol,
+            dense_output=True,
+            events=(separation, turning, released),
+            max_step=_MAX_STEP,
+            first_step=first_step,
         )
 
     ts: list[float] = [0.0]
@@ -306,8 +308,7 @@ def _simulate(
             if t1 > ts[-1]:  # a switch found where a run starts ends it with a null step
                 ts.append(t1)
                 pieces.append(piece)
-        turns.extend((te, ye[0]) for te, ye in zip(sol.t_events[1], sol.y_events[1])
-                     if te <= sol.t[n])
+        turns.extend((te, ye[0]) for te, ye in zip(sol.t_events[1], sol.y_events[1]) if te <= sol.t[n])
 
     t, y = 0.0, np.array([0.0, 1.0] + ([w0 / v] if oblique else []))
     first, redone = _FIRST_STEP, math.nan
@@ -344,9 +345,7 @@ def _simulate(
             break
         first, redone = None, math.nan
     else:
-        raise RuntimeError(
-            f"no separation after {_MAX_PHASES} switches between pushing and coasting"
-        )
+        raise RuntimeError(f"no separation after {_MAX_PHASES} switches between pushing and coasting")
     dmax = d_s * min(turns)[1] if turns else 0.0
     traj = OdeSolution(ts, pieces)
 
@@ -362,8 +361,7 @@ def _simulate(
 
     i = int(np.argmax(f))
     lo, hi = tau[max(i - 1, 0)], tau[min(i + 1, n_samples - 1)]
-    best = minimize_scalar(neg_force, bounds=(lo, hi), method="bounded",
-                           options={"xatol": 1e-12 * tau_sep})
+    best = minimize_scalar(neg_force, bounds=(lo, hi), method="bounded", options={"xatol": 1e-12 * tau_sep})
     peak = max(float(f[i]), -float(best.fun))
     if oblique:
         wt = v * y[2]
@@ -371,16 +369,30 @@ def _simulate(
     else:
         wt, ft = np.zeros(n_samples), np.zeros(n_samples)
     return ImpactResult(
-        times=tau * t_s, penetration=delta, penetration_rate=rate, force=f,
-        peak_force=peak, max_penetration=dmax, duration=tau_sep * t_s,
-        restitution=-float(y_sep[1]), approach_speed=v, mass=m,
-        tangential_velocity=wt, tangential_force=ft,
+        times=tau * t_s,
+        penetration=delta,
+        penetration_rate=rate,
+        force=f,
+        peak_force=peak,
+        max_penetration=dmax,
+        duration=tau_sep * t_s,
+        restitution=-float(y_sep[1]),
+        approach_speed=v,
+        mass=m,
+        tangential_velocity=wt,
+        tangential_force=ft,
     )
 
 
 def simulate_impact(
-    force: ForceLaw, *, mass: float, speed: float, rtol: float = 1e-10,
-    atol: float | None = None, max_duration: float | None = None, n_samples: int = 2000,
+    force: ForceLaw,
+    *,
+    mass: float,
+    speed: float,
+    rtol: float = 1e-10,
+    atol: float | None = None,
+    max_duration: float | None = None,
+    n_samples: int = 2000,
 ) -> ImpactResult:
     """Normal impact of a point mass on a wall under a contact law.
 
@@ -406,14 +418,22 @@ def simulate_impact(
         ValueError: if an argument is out of range, or the law cannot stop the mass.
         RuntimeError: if the mass has not separated after ``max_duration``.
     """
-    return _simulate(force, mass, speed, None, 0.0, 1e-4, 1e-3, rtol, atol, max_duration,
-                     n_samples)
+    return _simulate(force, mass, speed, None, 0.0, 1e-4, 1e-3, rtol, atol, max_duration, n_samples)
 
 
 def simulate_oblique_impact(
-    force: ForceLaw, *, mass: float, normal_speed: float, tangential_speed: float,
-    friction: float, v0: float = 1e-4, v1: float = 1e-3, rtol: float = 1e-10,
-    atol: float | None = None, max_duration: float | None = None, n_samples: int = 2000,
+    force: ForceLaw,
+    *,
+    mass: float,
+    normal_speed: float,
+    tangential_speed: float,
+    friction: float,
+    v0: float = 1e-4,
+    v1: float = 1e-3,
+    rtol: float = 1e-10,
+    atol: float | None = None,
+    max_duration: float | None = None,
+    n_samples: int = 2000,
 ) -> ImpactResult:
     """Oblique impact: `simulate_impact` plus sliding along the wall.
 
@@ -441,13 +461,20 @@ def simulate_oblique_impact(
         ValueError: if an argument is out of range.
         RuntimeError: if the mass has not separated after ``max_duration``.
     """
-    return _simulate(force, mass, normal_speed, tangential_speed, friction, v0, v1, rtol, atol,
-                     max_duration, n_samples)
+    return _simulate(force, mass, normal_speed, tangential_speed, friction, v0, v1, rtol, atol, max_duration, n_samples)
 
 
 def law_impact(
-    law: ContactLaw, *, mass: float, speed: float, stiffness: float, restitution: float,
-    exponent: float = 1.5, c_max: float | None = None, d_max: float | None = None, **kw: Any,
+    law: ContactLaw,
+    *,
+    mass: float,
+    speed: float,
+    stiffness: float,
+    restitution: float,
+    exponent: float = 1.5,
+    c_max: float | None = None,
+    d_max: float | None = None,
+    **kw: Any,
 ) -> ImpactResult:
     """`simulate_impact` under one of the laws of `clearance.contact_calibration.laws`.
 
@@ -470,8 +497,9 @@ def law_impact(
         ValueError: if a law parameter is out of range (checked once, up front).
     """
     # Validate once through the public law, then integrate with the unchecked kernels.
-    laws.normal_force(law, 1e-6, 0.0, 1.0, stiffness=stiffness, restitution=restitution,
-                      exponent=exponent, c_max=c_max, d_max=d_max)
+    laws.normal_force(
+        law, 1e-6, 0.0, 1.0, stiffness=stiffness, restitution=restitution, exponent=exponent, c_max=c_max, d_max=d_max
+    )
     k, n = float(stiffness), float(exponent)
     if law is ContactLaw.IMPACT:
         c, dm = float(c_max), float(d_max)  # type: ignore[arg-type]
@@ -502,6 +530,11 @@ def clearance_impact(clearance: Clearance, *, mass: float, speed: float, **kw: A
     Returns:
         The simulated impact.
     """
-    return law_impact(clearance.law, mass=mass, speed=speed,
-                      stiffness=laws.bearing_stiffness(clearance),
-                      restitution=clearance.restitution, **kw)
+    return law_impact(
+        clearance.law,
+        mass=mass,
+        speed=speed,
+        stiffness=laws.bearing_stiffness(clearance),
+        restitution=clearance.restitution,
+        **kw,
+    )

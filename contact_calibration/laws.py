@@ -29,6 +29,7 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from clearance.checks import positive
 from clearance.model import Clearance, ContactLaw, Material
 
 __all__ = [
@@ -77,22 +78,13 @@ def _warn_unverified(law: ContactLaw) -> None:
             "contact law 'hu_guo': its hysteresis factor 3(1 - c_e)/(2 c_e) is recalled, not "
             "checked against the paper (REFERENCES.md section 1: one public code uses half this "
             "factor); check it before relying on the results",
-            UnverifiedLawWarning, stacklevel=3,
+            UnverifiedLawWarning,
+            stacklevel=3,
         )
 
 
 def _out(x: np.ndarray) -> Force:
     return float(x) if np.ndim(x) == 0 else x
-
-
-def _positive_scalar(name: str, value: float, unit: str) -> float:
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} must be a positive finite number (got {value!r})") from None
-    if not math.isfinite(v) or v <= 0:
-        raise ValueError(f"{name} must be positive and finite (got {value!r} {unit})")
-    return v
 
 
 def _positive_array(name: str, value: ArrayLike, unit: str) -> np.ndarray:
@@ -142,15 +134,11 @@ def bearing_stiffness_from(
     Raises:
         ValueError: if a radius is not positive and finite or R_J >= R_B.
     """
-    rb = _positive_scalar("bearing_radius", bearing_radius, "m")
-    rj = _positive_scalar("journal_radius", journal_radius, "m")
+    rb = positive("bearing_radius", bearing_radius, "m")
+    rj = positive("journal_radius", journal_radius, "m")
     if rj >= rb:
-        raise ValueError(
-            f"journal_radius must be < bearing_radius = {rb} m (got {journal_radius!r} m)"
-        )
-    sigma = sum(
-        (1.0 - m.poisson_ratio**2) / m.youngs_modulus for m in (bearing_material, journal_material)
-    )
+        raise ValueError(f"journal_radius must be < bearing_radius = {rb} m (got {journal_radius!r} m)")
+    sigma = sum((1.0 - m.poisson_ratio**2) / m.youngs_modulus for m in (bearing_material, journal_material))
     return 4.0 / (3.0 * sigma) * math.sqrt(rb * rj / (rb - rj))
 
 
@@ -177,8 +165,12 @@ def _elastic(delta: ArrayLike, stiffness: float, exponent: float) -> np.ndarray:
 
 
 def _dissipative(
-    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike,
-    stiffness: float, chi: float, exponent: float,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    approach_speed: ArrayLike,
+    stiffness: float,
+    chi: float,
+    exponent: float,
 ) -> np.ndarray:
     """K δⁿ [1 + χ δ̇/δ̇⁻] clipped at >= 0; no validation (callers validate once)."""
     ratio = np.asarray(delta_dot, dtype=float) / approach_speed
@@ -199,25 +191,35 @@ def hertz(delta: ArrayLike, *, stiffness: float, exponent: float = 1.5) -> Force
     Raises:
         ValueError: if stiffness or exponent is not positive and finite.
     """
-    k = _positive_scalar("stiffness", stiffness, "N/m^n")
-    n = _positive_scalar("exponent", exponent, "")
+    k = positive("stiffness", stiffness, "N/m^n")
+    n = positive("exponent", exponent, "")
     return _out(_elastic(delta, k, n))
 
 
 def _law(
-    law: ContactLaw, delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike,
-    stiffness: float, restitution: float, exponent: float,
+    law: ContactLaw,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    approach_speed: ArrayLike,
+    stiffness: float,
+    restitution: float,
+    exponent: float,
 ) -> Force:
-    k = _positive_scalar("stiffness", stiffness, "N/m^n")
-    n = _positive_scalar("exponent", exponent, "")
+    k = positive("stiffness", stiffness, "N/m^n")
+    n = positive("exponent", exponent, "")
     v = _positive_array("approach_speed", approach_speed, "m/s")
     chi = hysteresis_factor(law, restitution)
     return _out(_dissipative(delta, delta_dot, v, k, chi, n))
 
 
 def lankarani_nikravesh(
-    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
-    stiffness: float, restitution: float, exponent: float = 1.5,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    approach_speed: ArrayLike,
+    *,
+    stiffness: float,
+    restitution: float,
+    exponent: float = 1.5,
 ) -> Force:
     """Lankarani–Nikravesh (1990): F = K δⁿ [1 + 3(1 − cₑ²)/4 · δ̇/δ̇⁻].
 
@@ -241,13 +243,17 @@ def lankarani_nikravesh(
         ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
             restitution is out of range.
     """
-    return _law(ContactLaw.LANKARANI_NIKRAVESH, delta, delta_dot, approach_speed,
-                stiffness, restitution, exponent)
+    return _law(ContactLaw.LANKARANI_NIKRAVESH, delta, delta_dot, approach_speed, stiffness, restitution, exponent)
 
 
 def hunt_crossley(
-    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
-    stiffness: float, restitution: float, exponent: float = 1.5,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    approach_speed: ArrayLike,
+    *,
+    stiffness: float,
+    restitution: float,
+    exponent: float = 1.5,
 ) -> Force:
     """Hunt–Crossley (1975): F = K δⁿ [1 + 3(1 − cₑ)/2 · δ̇/δ̇⁻].
 
@@ -270,13 +276,17 @@ def hunt_crossley(
         ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
             restitution is out of range.
     """
-    return _law(ContactLaw.HUNT_CROSSLEY, delta, delta_dot, approach_speed,
-                stiffness, restitution, exponent)
+    return _law(ContactLaw.HUNT_CROSSLEY, delta, delta_dot, approach_speed, stiffness, restitution, exponent)
 
 
 def flores(
-    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
-    stiffness: float, restitution: float, exponent: float = 1.5,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    approach_speed: ArrayLike,
+    *,
+    stiffness: float,
+    restitution: float,
+    exponent: float = 1.5,
 ) -> Force:
     """Flores et al. (2011): F = K δⁿ [1 + 8(1 − cₑ)/(5cₑ) · δ̇/δ̇⁻].
 
@@ -299,13 +309,17 @@ def flores(
         ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
             restitution is out of range.
     """
-    return _law(ContactLaw.FLORES, delta, delta_dot, approach_speed,
-                stiffness, restitution, exponent)
+    return _law(ContactLaw.FLORES, delta, delta_dot, approach_speed, stiffness, restitution, exponent)
 
 
 def gonthier(
-    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
-    stiffness: float, restitution: float, exponent: float = 1.5,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    approach_speed: ArrayLike,
+    *,
+    stiffness: float,
+    restitution: float,
+    exponent: float = 1.5,
 ) -> Force:
     """Gonthier et al. (2004): F = K δⁿ [1 + (1 − cₑ²)/cₑ · δ̇/δ̇⁻].
 
@@ -328,13 +342,17 @@ def gonthier(
         ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
             restitution is out of range.
     """
-    return _law(ContactLaw.GONTHIER, delta, delta_dot, approach_speed,
-                stiffness, restitution, exponent)
+    return _law(ContactLaw.GONTHIER, delta, delta_dot, approach_speed, stiffness, restitution, exponent)
 
 
 def hu_guo(
-    delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike, *,
-    stiffness: float, restitution: float, exponent: float = 1.5,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    approach_speed: ArrayLike,
+    *,
+    stiffness: float,
+    restitution: float,
+    exponent: float = 1.5,
 ) -> Force:
     """Hu–Guo (2015): F = K δⁿ [1 + 3(1 − cₑ)/(2cₑ) · δ̇/δ̇⁻]. UNVERIFIED.
 
@@ -359,8 +377,7 @@ def hu_guo(
         ValueError: if approach_speed is not positive and finite, or stiffness, exponent or
             restitution is out of range.
     """
-    return _law(ContactLaw.HU_GUO, delta, delta_dot, approach_speed,
-                stiffness, restitution, exponent)
+    return _law(ContactLaw.HU_GUO, delta, delta_dot, approach_speed, stiffness, restitution, exponent)
 
 
 def _step_cubic(delta: np.ndarray, d_max: float) -> np.ndarray:
@@ -369,8 +386,12 @@ def _step_cubic(delta: np.ndarray, d_max: float) -> np.ndarray:
 
 
 def _impact(
-    delta: ArrayLike, delta_dot: ArrayLike, stiffness: float, exponent: float,
-    c_max: float, d_max: float,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    stiffness: float,
+    exponent: float,
+    c_max: float,
+    d_max: float,
 ) -> np.ndarray:
     d = np.asarray(delta, dtype=float)
     damping = c_max * _step_cubic(d, d_max) * np.asarray(delta_dot, dtype=float)
@@ -379,8 +400,13 @@ def _impact(
 
 
 def impact_law(
-    delta: ArrayLike, delta_dot: ArrayLike, *, stiffness: float, exponent: float = 1.5,
-    c_max: float, d_max: float,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    *,
+    stiffness: float,
+    exponent: float = 1.5,
+    c_max: float,
+    d_max: float,
 ) -> Force:
     """MSC Adams IMPACT: F = max(0, K δⁿ + STEP(δ; 0, 0, d_max, C_max) δ̇) for δ > 0.
 
@@ -404,22 +430,19 @@ def impact_law(
     Raises:
         ValueError: if an argument is out of range.
     """
-    k = _positive_scalar("stiffness", stiffness, "N/m^n")
-    n = _positive_scalar("exponent", exponent, "")
+    k = positive("stiffness", stiffness, "N/m^n")
+    n = positive("exponent", exponent, "")
     c, d = _impact_params(c_max, d_max)
     return _out(_impact(delta, delta_dot, k, n, c, d))
 
 
 def _impact_params(c_max: float | None, d_max: float | None) -> tuple[float, float]:
     if c_max is None or d_max is None:
-        raise ValueError(
-            f"the IMPACT law needs c_max [N s/m] and d_max [m] (got c_max={c_max!r}, "
-            f"d_max={d_max!r})"
-        )
+        raise ValueError(f"the IMPACT law needs c_max [N s/m] and d_max [m] (got c_max={c_max!r}, d_max={d_max!r})")
     c = float(c_max)
     if not (math.isfinite(c) and c >= 0):
         raise ValueError(f"c_max must be >= 0 and finite (got {c_max!r} N s/m)")
-    return c, _positive_scalar("d_max", d_max, "m")
+    return c, positive("d_max", d_max, "m")
 
 
 _FACTORS = {
@@ -465,9 +488,16 @@ def hysteresis_factor(law: ContactLaw, restitution: float) -> float:
 
 
 def normal_force(
-    law: ContactLaw, delta: ArrayLike, delta_dot: ArrayLike, approach_speed: ArrayLike | None,
-    *, stiffness: float, restitution: float, exponent: float = 1.5,
-    c_max: float | None = None, d_max: float | None = None,
+    law: ContactLaw,
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    approach_speed: ArrayLike | None,
+    *,
+    stiffness: float,
+    restitution: float,
+    exponent: float = 1.5,
+    c_max: float | None = None,
+    d_max: float | None = None,
 ) -> Force:
     """Normal contact force [N] of any `ContactLaw` (dispatch to the functions above).
 
@@ -494,14 +524,17 @@ def normal_force(
     if law is ContactLaw.HERTZ:
         return hertz(delta, stiffness=stiffness, exponent=exponent)
     if law is ContactLaw.IMPACT:
-        return impact_law(delta, delta_dot, stiffness=stiffness, exponent=exponent,
-                          c_max=c_max, d_max=d_max)  # type: ignore[arg-type]
+        return impact_law(delta, delta_dot, stiffness=stiffness, exponent=exponent, c_max=c_max, d_max=d_max)  # type: ignore[arg-type]
     return _law(law, delta, delta_dot, approach_speed, stiffness, restitution, exponent)
 
 
 def ambrosio_friction(
-    normal_force: ArrayLike, tangential_velocity: ArrayLike, *,
-    friction: float, v0: float = 1e-4, v1: float = 1e-3,
+    normal_force: ArrayLike,
+    tangential_velocity: ArrayLike,
+    *,
+    friction: float,
+    v0: float = 1e-4,
+    v1: float = 1e-3,
 ) -> Force:
     """Ambrósio's modified Coulomb friction: F_T = −μ c_d(|v_T|) F_N v_T/|v_T|.
 

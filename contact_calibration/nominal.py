@@ -17,6 +17,8 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from scipy.optimize import brentq
+
 from clearance.contact_calibration.impact import law_impact, simulate_impact
 from clearance.contact_calibration.laws import bearing_stiffness
 from clearance.mjcf.bearing import (
@@ -24,8 +26,6 @@ from clearance.mjcf.bearing import (
     ring_damping_coefficient,
     ring_stiffness_coefficient,
 )
-from scipy.optimize import brentq
-
 from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters
 
@@ -74,9 +74,13 @@ def nominal_parameters(
         ContactParameters with source "nominal".
     """
     K = bearing_stiffness(clearance)
-    ln = law_impact(
-        clearance.law, mass=effective_mass, speed=impact_speed, stiffness=K, restitution=clearance.restitution
-    ) if clearance.law is not ContactLaw.IMPACT else None
+    ln = (
+        law_impact(
+            clearance.law, mass=effective_mass, speed=impact_speed, stiffness=K, restitution=clearance.restitution
+        )
+        if clearance.law is not ContactLaw.IMPACT
+        else None
+    )
     delta_ref = ln.max_penetration if ln is not None else (5 * effective_mass * impact_speed**2 / (4 * K)) ** 0.4
     c_k = ring_stiffness_coefficient(geom, (delta_ref / 20, delta_ref * 2))
     k = K / c_k

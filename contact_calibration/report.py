@@ -11,11 +11,12 @@ from __future__ import annotations
 import io
 import math
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Sequence
 
 import numpy as np
+
 from clearance.contact_calibration.fit import (
     GOALS,
     CalibrationResult,
@@ -23,7 +24,6 @@ from clearance.contact_calibration.fit import (
     evaluate,
 )
 from clearance.mjcf.bearing import RingGeometry
-
 from clearance.model import Clearance
 from clearance.options import ModelOptions
 from clearance.results import atomic_write_bytes
@@ -49,26 +49,38 @@ def accuracy_table(rows: Sequence[SpeedRow]) -> str:
 
     Each cell gives the direction mean and, in brackets, the worst direction.
     """
-    head = ("| v [m/s] | LN peak F [N] | LN δmax [µm] | LN T [µs] | LN e | peak F err | δmax err "
-            "| T err | e − e_LN | goals |\n|---|---|---|---|---|---|---|---|---|---|\n")
+    head = (
+        "| v [m/s] | LN peak F [N] | LN δmax [µm] | LN T [µs] | LN e | peak F err | δmax err "
+        "| T err | e − e_LN | goals |\n|---|---|---|---|---|---|---|---|---|---|\n"
+    )
     lines = []
     for r in rows:
         cells = [
-            f"{_mark(r.peak_force_err, GOALS['peak_force'], True)} ({_mark(r.peak_force_worst, GOALS['peak_force'], True)})",
-            f"{_mark(r.max_penetration_err, GOALS['max_penetration'], True)} ({_mark(r.max_penetration_worst, GOALS['max_penetration'], True)})",
-            f"{_mark(r.duration_err, GOALS['duration'], True)} ({_mark(r.duration_worst, GOALS['duration'], True)})",
-            f"{_mark(r.restitution_err, GOALS['restitution'], False)} ({_mark(r.restitution_worst, GOALS['restitution'], False)})",
+            f"{_mark(mean, GOALS[goal], pct)} ({_mark(worst, GOALS[goal], pct)})"
+            for mean, worst, goal, pct in (
+                (r.peak_force_err, r.peak_force_worst, "peak_force", True),
+                (r.max_penetration_err, r.max_penetration_worst, "max_penetration", True),
+                (r.duration_err, r.duration_worst, "duration", True),
+                (r.restitution_err, r.restitution_worst, "restitution", False),
+            )
         ]
         lines.append(
             f"| {r.speed:.3g} | {r.ln_peak_force:.4g} | {r.ln_max_penetration * 1e6:.3g} | "
-            f"{r.ln_duration * 1e6:.3g} | {r.ln_restitution:.4f} | " + " | ".join(cells)
+            f"{r.ln_duration * 1e6:.3g} | {r.ln_restitution:.4f} | "
+            + " | ".join(cells)
             + f" | {'met' if r.meets_goals() else 'missed'} |"
         )
     return head + "\n".join(lines) + "\n"
 
 
-def _markdown(result: CalibrationResult, clearance: Clearance, ring: RingGeometry,
-              options: ModelOptions, title: str, source: str | None) -> str:
+def _markdown(
+    result: CalibrationResult,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    title: str,
+    source: str | None,
+) -> str:
     p, s = result.parameters, result.stability
     met = sum(r.meets_goals() for r in result.rows)
     lo, hi = result.mass_range
@@ -89,20 +101,33 @@ def _markdown(result: CalibrationResult, clearance: Clearance, ring: RingGeometr
         + f"\nGoals: peak force and max penetration within {GOALS['peak_force']:.0%}, duration within "
         f"{GOALS['duration']:.0%}, restitution within {GOALS['restitution']} of the LN impact's own. "
         f"Cells: mean over impact directions (worst direction); bold = outside the goal. "
-        f"{met} of {len(result.rows)} speeds meet all goals.\n\n"
-        + accuracy_table(result.rows)
+        f"{met} of {len(result.rows)} speeds meet all goals.\n\n" + accuracy_table(result.rows)
     )
 
 
-def _plot(result: CalibrationResult, clearance: Clearance, ring: RingGeometry,
-          options: ModelOptions, speeds: np.ndarray, path: Path, exact: bool) -> None:
+def _plot(
+    result: CalibrationResult,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    speeds: np.ndarray,
+    path: Path,
+    exact: bool,
+) -> None:
     # A Figure with its own Agg canvas: no pyplot, so the caller's backend (a notebook's,
     # say) and its open figures are left alone.
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
 
-    err, imps, refs = evaluate(clearance, ring, options, result.parameters, mass=result.mass,
-                               speeds=speeds, directions=np.array(result.directions))
+    err, imps, refs = evaluate(
+        clearance,
+        ring,
+        options,
+        result.parameters,
+        mass=result.mass,
+        speeds=speeds,
+        directions=np.array(result.directions),
+    )
     fig = Figure(figsize=(4.2 * len(speeds), 3.6))
     FigureCanvasAgg(fig)
     axes = fig.subplots(1, len(speeds), squeeze=False)
@@ -110,13 +135,13 @@ def _plot(result: CalibrationResult, clearance: Clearance, ring: RingGeometry,
         ax.plot(ref.times * 1e6, ref.force, "k-", lw=2, label="LN reference")
         for imp, style in zip(row, ("C0--", "C1:")):
             frac = imp.direction * ring.segments / (2 * math.pi)
-            ax.plot(imp.times * 1e6, imp.force, style, lw=1.5,
-                    label=f"MuJoCo calibrated, ψ = {frac:.2g}·2π/N")
+            ax.plot(imp.times * 1e6, imp.force, style, lw=1.5, label=f"MuJoCo calibrated, ψ = {frac:.2g}·2π/N")
         if exact:
             from clearance.contact_calibration.exact_ln import exact_ln_impact
 
-            ex = exact_ln_impact(clearance, ring, options, mass=result.mass, speed=float(v),
-                                 direction=float(result.directions[-1]))
+            ex = exact_ln_impact(
+                clearance, ring, options, mass=result.mass, speed=float(v), direction=float(result.directions[-1])
+            )
             ax.plot(ex.times * 1e6, ex.force, "C3-.", lw=1, label="MuJoCo exact-LN")
         ax.set_title(f"v = {v:.3g} m/s")
         ax.set_xlabel("time from contact [µs]")
@@ -131,9 +156,17 @@ def _plot(result: CalibrationResult, clearance: Clearance, ring: RingGeometry,
 
 
 def calibration_report(
-    result: CalibrationResult, clearance: Clearance, ring: RingGeometry, options: ModelOptions,
-    *, out_dir: str | os.PathLike, stem: str = "calibration", title: str = "Contact calibration",
-    plot_speeds: Sequence[float] | None = None, exact_ln: bool = True, source: str | None = None,
+    result: CalibrationResult,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    *,
+    out_dir: str | os.PathLike,
+    stem: str = "calibration",
+    title: str = "Contact calibration",
+    plot_speeds: Sequence[float] | None = None,
+    exact_ln: bool = True,
+    source: str | None = None,
 ) -> ReportFiles:
     """Write the Markdown report and the force–time plot of a calibration.
 

@@ -26,6 +26,7 @@ from dataclasses import dataclass
 import mujoco
 import mujoco.rollout
 import numpy as np
+
 from clearance.mjcf.bearing import RingGeometry, segment_centres
 
 __all__ = ["SceneImpact", "ring_gap", "onset_radius", "scene_impacts", "DEFAULT_DIRECTIONS"]
@@ -197,10 +198,16 @@ def _measure(
     delta = np.linalg.norm(q, axis=1) - ring.radial_clearance
     lo, hi = max(first - 1, 0), min(last + 2, len(force))
     fpk, _ = _peak(force[lo:hi])
-    dpk, _ = _peak(delta[lo:hi + 1])
+    dpk, _ = _peak(delta[lo : hi + 1])
     t = np.arange(len(force)) * h - t_on
     return SceneImpact(
-        speed=v, direction=psi, times=t[lo:hi], penetration=delta[lo:hi], force=force[lo:hi],
-        peak_force=fpk, max_penetration=dpk, duration=t_off - t_on,
+        speed=v,
+        direction=psi,
+        times=t[lo:hi],
+        penetration=delta[lo:hi],
+        force=force[lo:hi],
+        peak_force=fpk,
+        max_penetration=dpk,
+        duration=t_off - t_on,
         restitution=-float(qd[last + 2] @ u) / v,
     )

@@ -28,6 +28,7 @@ from typing import Any
 
 import mujoco
 import numpy as np
+
 from clearance.contact_calibration.fit import (
     FIT_VERSION,
     CalibrationResult,
@@ -36,7 +37,6 @@ from clearance.contact_calibration.fit import (
     fit_contact,
 )
 from clearance.mjcf.bearing import RingGeometry
-
 from clearance.model import Clearance, Joint
 from clearance.options import ContactParameters, ModelOptions
 from clearance.results import atomic_write_bytes
@@ -78,8 +78,13 @@ def cache_dir() -> Path:
 
 
 def calibration_key(
-    clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
-    mass_range: tuple[float, float], speeds: np.ndarray,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    *,
+    mass: float,
+    mass_range: tuple[float, float],
+    speeds: np.ndarray,
 ) -> dict[str, Any]:
     """Everything a calibration depends on, as a JSON-ready dict.
 
@@ -172,7 +177,9 @@ def load_calibration(key: dict[str, Any], directory: Path | None = None) -> Cali
     except (OSError, ValueError, KeyError, TypeError, AttributeError) as exc:
         warnings.warn(
             f"calibration file {path} is corrupt or inconsistent ({type(exc).__name__}: "
-            f"{exc}); ignoring it and recalibrating", CalibrationCacheWarning, stacklevel=3,
+            f"{exc}); ignoring it and recalibrating",
+            CalibrationCacheWarning,
+            stacklevel=3,
         )
         return None
     return result
@@ -188,9 +195,15 @@ def save_calibration(key: dict[str, Any], result: CalibrationResult, directory: 
 
 
 def calibrate(
-    clearance: Clearance, ring: RingGeometry, options: ModelOptions, *, mass: float,
-    impact_speed: float | None = None, speeds: np.ndarray | None = None,
-    mass_range: tuple[float, float] | None = None, max_penetration: float | None = None,
+    clearance: Clearance,
+    ring: RingGeometry,
+    options: ModelOptions,
+    *,
+    mass: float,
+    impact_speed: float | None = None,
+    speeds: np.ndarray | None = None,
+    mass_range: tuple[float, float] | None = None,
+    max_penetration: float | None = None,
     use_cache: bool = True,
 ) -> tuple[CalibrationResult, Path | None]:
     """Calibrate one bearing, reusing a stored calibration with the same inputs.
@@ -227,11 +240,13 @@ def calibrate(
         hit = load_calibration(key)
         if hit is not None:
             if max_penetration is not None:
-                check_stability(ring, hit.parameters, mass=mass, timestep=options.timestep,
-                                max_penetration=max_penetration)
+                check_stability(
+                    ring, hit.parameters, mass=mass, timestep=options.timestep, max_penetration=max_penetration
+                )
             return hit, calibration_path(key)
-    result = fit_contact(clearance, ring, options, mass=mass, speeds=speeds, mass_range=mrange,
-                         max_penetration=max_penetration)
+    result = fit_contact(
+        clearance, ring, options, mass=mass, speeds=speeds, mass_range=mrange, max_penetration=max_penetration
+    )
     if not use_cache:
         return result, None
     try:
@@ -241,14 +256,21 @@ def calibrate(
         warnings.warn(
             f"could not store the calibration in {folder} ({type(exc).__name__}: {exc}); "
             f"using the fit without caching it. Set ${CACHE_ENV} to a writable folder to "
-            "reuse calibrations between runs", CalibrationCacheWarning, stacklevel=2,
+            "reuse calibrations between runs",
+            CalibrationCacheWarning,
+            stacklevel=2,
         )
         return result, None
 
 
 def calibrate_joint(
-    joint: Joint, ring: RingGeometry, sizing: Any, options: ModelOptions, *,
-    speeds: np.ndarray | None = None, use_cache: bool = True,
+    joint: Joint,
+    ring: RingGeometry,
+    sizing: Any,
+    options: ModelOptions,
+    *,
+    speeds: np.ndarray | None = None,
+    use_cache: bool = True,
 ) -> tuple[CalibrationResult, Path | None]:
     """Calibrate a clearance joint of a prepared model at its own sizing (cached).
 
@@ -278,10 +300,17 @@ def calibrate_joint(
     if joint.clearance is None:
         raise ValueError(f"joint '{joint.name}' has no clearance to calibrate")
     mrange = getattr(sizing, "effective_mass_range", None)
-    return calibrate(joint.clearance, ring, options, mass=float(sizing.effective_mass),
-                     impact_speed=float(sizing.impact_speed), speeds=speeds,
-                     mass_range=tuple(mrange) if mrange else None,
-                     max_penetration=float(sizing.penetration_limit), use_cache=use_cache)
+    return calibrate(
+        joint.clearance,
+        ring,
+        options,
+        mass=float(sizing.effective_mass),
+        impact_speed=float(sizing.impact_speed),
+        speeds=speeds,
+        mass_range=tuple(mrange) if mrange else None,
+        max_penetration=float(sizing.penetration_limit),
+        use_cache=use_cache,
+    )
 
 
 def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Any, options: ModelOptions) -> ContactParameters:

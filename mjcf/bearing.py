@@ -63,7 +63,12 @@ class RingGeometry:
 
     @classmethod
     def make(
-        cls, bearing_radius: float, radial_clearance: float, segments: int, *, flat: bool = False,
+        cls,
+        bearing_radius: float,
+        radial_clearance: float,
+        segments: int,
+        *,
+        flat: bool = False,
         contacts_per_pair: int = 1,
     ) -> RingGeometry:
         """Ring with round segments of the default radius, or flat (box) faces."""

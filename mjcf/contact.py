@@ -11,8 +11,8 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
-from clearance.mjcf.spec import BuiltModel
 
+from clearance.mjcf.spec import BuiltModel
 from clearance.options import ContactParameters
 
 __all__ = ["apply_contact", "row_inverse_weight", "effective_masses", "initial_velocity", "add_initial_keyframe"]

@@ -9,9 +9,9 @@ from __future__ import annotations
 
 import mujoco
 import numpy as np
+
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.spec import _journal_and_bearing
-
 from clearance.options import ContactParameters, ModelOptions
 
 __all__ = ["ring_scene", "static_ring_force", "measured_ripple"]

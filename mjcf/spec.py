@@ -23,10 +23,10 @@ from dataclasses import dataclass
 
 import mujoco
 import numpy as np
-from clearance.mjcf.bearing import RingGeometry, segment_centres
-from clearance.mjcf.tree import BodyTree, body_tree
 
 from clearance.kinematics import assemble, velocities
+from clearance.mjcf.bearing import RingGeometry, segment_centres
+from clearance.mjcf.tree import BodyTree, body_tree
 from clearance.model import DriveKind, Joint, JointType, Mechanism, OutputKind
 from clearance.options import GeomType, ModelOptions
 
@@ -152,9 +152,7 @@ def build_spec(
         par, joint = tree.parent[child]
         lk = links[child]
         rel = _to_frame(pose[par], pose[child][:2])
-        body = bodies[par].add_body(
-            name=child, pos=[rel[0], rel[1], 0.0], quat=_quat(pose[child][2] - pose[par][2])
-        )
+        body = bodies[par].add_body(name=child, pos=[rel[0], rel[1], 0.0], quat=_quat(pose[child][2] - pose[par][2]))
         body.mass = lk.mass
         body.inertia = [lk.inertia, lk.inertia, lk.inertia]
         body.ipos = [lk.com[0], lk.com[1], 0.0]
@@ -165,18 +163,26 @@ def build_spec(
         if joint.kind is JointType.PRISMATIC:
             th_a = pose[joint.link_a][2]
             world_axis = np.array(
-                [math.cos(th_a) * joint.axis[0] - math.sin(th_a) * joint.axis[1],
-                 math.sin(th_a) * joint.axis[0] + math.cos(th_a) * joint.axis[1]]
+                [
+                    math.cos(th_a) * joint.axis[0] - math.sin(th_a) * joint.axis[1],
+                    math.sin(th_a) * joint.axis[0] + math.cos(th_a) * joint.axis[1],
+                ]
             )
             c, s = math.cos(pose[child][2]), math.sin(pose[child][2])
             ax = [c * world_axis[0] + s * world_axis[1], -s * world_axis[0] + c * world_axis[1], 0.0]
             body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=ax, pos=[anchor[0], anchor[1], 0])
         elif joint.clearance is None:
-            body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], pos=[anchor[0], anchor[1], 0])
+            body.add_joint(
+                name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], pos=[anchor[0], anchor[1], 0]
+            )
         else:
             for k, ax in (("x", [1, 0, 0]), ("y", [0, 1, 0])):
-                body.add_joint(name=f"{joint.name}__{k}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=ax, pos=[anchor[0], anchor[1], 0])
-            body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], pos=[anchor[0], anchor[1], 0])
+                body.add_joint(
+                    name=f"{joint.name}__{k}", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=ax, pos=[anchor[0], anchor[1], 0]
+                )
+            body.add_joint(
+                name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], pos=[anchor[0], anchor[1], 0]
+            )
         _visual_link(body, lk)
 
     # ideal cuts -> connect equalities
@@ -185,7 +191,9 @@ def build_spec(
         pa = links[j.link_a].point(j.point_a)
         pb = links[j.link_b].point(j.point_b)
         eq = spec.add_equality(
-            name=j.name, type=mujoco.mjtEq.mjEQ_CONNECT, objtype=_OBJ.mjOBJ_BODY,
+            name=j.name,
+            type=mujoco.mjtEq.mjEQ_CONNECT,
+            objtype=_OBJ.mjOBJ_BODY,
             name1=j.link_a if j.link_a != mechanism.ground else "world",
             name2=j.link_b if j.link_b != mechanism.ground else "world",
         )
@@ -193,7 +201,15 @@ def build_spec(
         eq.solref = [tc, 1.0]
         _site(bodies[j.link_a], f"{j.name}__a", pa)
         _site(bodies[j.link_b], f"{j.name}__b", pb)
-        _sensor(spec, f"{j.name}__closure", _SENS.mjSENS_FRAMEPOS, _OBJ.mjOBJ_SITE, f"{j.name}__b", _OBJ.mjOBJ_SITE, f"{j.name}__a")
+        _sensor(
+            spec,
+            f"{j.name}__closure",
+            _SENS.mjSENS_FRAMEPOS,
+            _OBJ.mjOBJ_SITE,
+            f"{j.name}__b",
+            _OBJ.mjOBJ_SITE,
+            f"{j.name}__a",
+        )
 
     rings, jbody, bbody = {}, {}, {}
     for j in mechanism.clearance_joints:
@@ -207,14 +223,28 @@ def build_spec(
         _journal_and_bearing(spec, bodies[jl], bodies[bl], j.name, jp, bp, ring, options, c.friction)
         _site(bodies[jl], f"{j.name}__journal", jp)
         _site(bodies[bl], f"{j.name}__bearing", bp)
-        _sensor(spec, f"{j.name}__ecc", _SENS.mjSENS_FRAMEPOS, _OBJ.mjOBJ_SITE, f"{j.name}__journal", _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
+        _sensor(
+            spec,
+            f"{j.name}__ecc",
+            _SENS.mjSENS_FRAMEPOS,
+            _OBJ.mjOBJ_SITE,
+            f"{j.name}__journal",
+            _OBJ.mjOBJ_SITE,
+            f"{j.name}__bearing",
+        )
         _sensor(spec, f"{j.name}__jvel", _SENS.mjSENS_FRAMELINVEL, _OBJ.mjOBJ_SITE, f"{j.name}__journal")
         _sensor(spec, f"{j.name}__bvel", _SENS.mjSENS_FRAMELINVEL, _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
         _sensor(spec, f"{j.name}__bangvel", _SENS.mjSENS_FRAMEANGVEL, _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
         _sensor(spec, f"{j.name}__bxaxis", _SENS.mjSENS_FRAMEXAXIS, _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
-        s = _sensor(spec, f"{j.name}__force", _SENS.mjSENS_CONTACT, _OBJ.mjOBJ_BODY,
-                    bl if bl != mechanism.ground else "world", _OBJ.mjOBJ_BODY,
-                    jl if jl != mechanism.ground else "world")
+        s = _sensor(
+            spec,
+            f"{j.name}__force",
+            _SENS.mjSENS_CONTACT,
+            _OBJ.mjOBJ_BODY,
+            bl if bl != mechanism.ground else "world",
+            _OBJ.mjOBJ_BODY,
+            jl if jl != mechanism.ground else "world",
+        )
         s.intprm[:3] = [2, 3, 1]  # data = force, reduce = netforce, num = 1
 
     for n in names:
@@ -228,7 +258,11 @@ def build_spec(
             _sensor(spec, f"{o.name}__angacc", _SENS.mjSENS_FRAMEANGACC, _OBJ.mjOBJ_BODY, o.link)
         else:
             _site(bodies[o.link], f"{o.name}__site", links[o.link].point(o.point))
-            for suffix, st in (("pos", _SENS.mjSENS_FRAMEPOS), ("vel", _SENS.mjSENS_FRAMELINVEL), ("acc", _SENS.mjSENS_FRAMELINACC)):
+            for suffix, st in (
+                ("pos", _SENS.mjSENS_FRAMEPOS),
+                ("vel", _SENS.mjSENS_FRAMELINVEL),
+                ("acc", _SENS.mjSENS_FRAMELINACC),
+            ):
                 _sensor(spec, f"{o.name}__{suffix}", st, _OBJ.mjOBJ_SITE, f"{o.name}__site")
 
     gears = drive_gear(tree, mechanism)
@@ -288,8 +322,12 @@ def _visual_link(body, link) -> None:
             a, b = pts[i], pts[k]
             if math.hypot(b[0] - a[0], b[1] - a[1]) < 1e-9:
                 continue
-            body.add_geom(type=mujoco.mjtGeom.mjGEOM_CAPSULE, size=[_THICK / 2, 0, 0],
-                          fromto=[a[0], a[1], -_THICK, b[0], b[1], -_THICK], **kw)
+            body.add_geom(
+                type=mujoco.mjtGeom.mjGEOM_CAPSULE,
+                size=[_THICK / 2, 0, 0],
+                fromto=[a[0], a[1], -_THICK, b[0], b[1], -_THICK],
+                **kw,
+            )
 
 
 def _geom_type(g: GeomType) -> int:
@@ -301,12 +339,22 @@ def _geom_type(g: GeomType) -> int:
     }[g]
 
 
-def _journal_and_bearing(spec, jbody, bbody, name, jp, bp, ring: RingGeometry, options: ModelOptions, friction: float) -> None:
+def _journal_and_bearing(
+    spec, jbody, bbody, name, jp, bp, ring: RingGeometry, options: ModelOptions, friction: float
+) -> None:
     nocol = dict(contype=0, conaffinity=0)
     jg = options.journal_geom
     size = [ring.journal_radius, _THICK, 0] if jg is not GeomType.SPHERE else [ring.journal_radius, 0, 0]
-    jbody.add_geom(name=f"{name}__journal", type=_geom_type(jg), size=size, pos=[jp[0], jp[1], 0],
-                   rgba=[0.85, 0.35, 0.2, 1.0], group=0, mass=0, **nocol)
+    jbody.add_geom(
+        name=f"{name}__journal",
+        type=_geom_type(jg),
+        size=size,
+        pos=[jp[0], jp[1], 0],
+        rgba=[0.85, 0.35, 0.2, 1.0],
+        group=0,
+        mass=0,
+        **nocol,
+    )
     sg = options.segment_geom
     centres = segment_centres(ring)
     rs = ring.segment_radius
@@ -318,8 +366,14 @@ def _journal_and_bearing(spec, jbody, bbody, name, jp, bp, ring: RingGeometry, o
             hx = 0.25 * ring.bearing_radius
             cx = bp[0] + (ring.bearing_radius + hx) * math.cos(phi)
             cy = bp[1] + (ring.bearing_radius + hx) * math.sin(phi)
-            g = bbody.add_geom(name=gname, type=mujoco.mjtGeom.mjGEOM_BOX, size=[hx, half_t, _THICK],
-                               pos=[cx, cy, 0], quat=_quat(phi), **nocol)
+            g = bbody.add_geom(
+                name=gname,
+                type=mujoco.mjtGeom.mjGEOM_BOX,
+                size=[hx, half_t, _THICK],
+                pos=[cx, cy, 0],
+                quat=_quat(phi),
+                **nocol,
+            )
         else:
             size = [rs, 0, 0] if sg is GeomType.SPHERE else [rs, _THICK, 0]
             g = bbody.add_geom(name=gname, type=_geom_type(sg), size=size, pos=[bp[0] + x, bp[1] + y, 0], **nocol)

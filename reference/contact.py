@@ -21,7 +21,6 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
 from clearance.contact_calibration.laws import bearing_stiffness, hysteresis_factor
-
 from clearance.model import Clearance, ContactLaw, Joint
 
 __all__ = ["ContactJoint", "contact_joints", "normal_force_scalar", "friction_scalar"]
@@ -117,12 +116,30 @@ def contact_joints(
             kind, chi = _HERTZ, 0.0
         else:
             kind, chi = _CHI, hysteresis_factor(cl.law, cl.restitution)
-        out.append(ContactJoint(
-            name=j.name, journal_link=jl, bearing_link=bl, ij=index[jl], ib=index[bl],
-            sj=sj, sb=sb, clearance=cl, c=cl.radial_clearance, rj=cl.journal_radius,
-            rb=cl.bearing_radius, stiffness=bearing_stiffness(cl), exponent=1.5, kind=kind,
-            chi=chi, mu=cl.friction, v0=float(v0), v1=float(v1), c_max=cm, d_max=dm,
-        ))
+        out.append(
+            ContactJoint(
+                name=j.name,
+                journal_link=jl,
+                bearing_link=bl,
+                ij=index[jl],
+                ib=index[bl],
+                sj=sj,
+                sb=sb,
+                clearance=cl,
+                c=cl.radial_clearance,
+                rj=cl.journal_radius,
+                rb=cl.bearing_radius,
+                stiffness=bearing_stiffness(cl),
+                exponent=1.5,
+                kind=kind,
+                chi=chi,
+                mu=cl.friction,
+                v0=float(v0),
+                v1=float(v1),
+                c_max=cm,
+                d_max=dm,
+            )
+        )
     return out
 
 
@@ -161,9 +178,7 @@ def friction_scalar(cj: ContactJoint, fn: float, vt: float) -> float:
     return -cj.mu * cd * fn * (1.0 if vt > 0 else -1.0)
 
 
-def evaluate_contact(
-    cj: ContactJoint, zl: Sequence[float], zdl: Sequence[float], vin: float
-) -> tuple[float, ...]:
+def evaluate_contact(cj: ContactJoint, zl: Sequence[float], zdl: Sequence[float], vin: float) -> tuple[float, ...]:
     """Geometry and force of one joint at centre-of-mass coordinates (plain floats).
 
     Args:

@@ -24,9 +24,10 @@ import math
 from collections.abc import Callable
 
 import numpy as np
+from scipy.optimize import brentq, minimize_scalar
+
 from clearance.reference.contact import evaluate_contact
 from clearance.reference.system import ReferenceSystem
-from scipy.optimize import brentq, minimize_scalar
 
 __all__ = ["gap", "gap_many", "hermite_extreme", "find_mode_change"]
 
@@ -78,8 +79,7 @@ def hermite_extreme(p0: float, p1: float, m0: float, m1: float, want_max: bool) 
     for s in cands:
         if 0.0 <= s <= 1.0:
             s2, s3 = s * s, s * s * s
-            vals.append((2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * m0
-                        + (-2 * s3 + 3 * s2) * p1 + (s3 - s2) * m1)
+            vals.append((2 * s3 - 3 * s2 + 1) * p0 + (s3 - 2 * s2 + s) * m0 + (-2 * s3 + 3 * s2) * p1 + (s3 - s2) * m1)
     return max(vals) if want_max else min(vals)
 
 
@@ -133,8 +133,9 @@ def find_mode_change(
             return float(brentq(g, a, b, xtol=1e-16, rtol=1e-14))
         ext = hermite_extreme(deltas[i], deltas[i + 1], dt * rates[i], dt * rates[i + 1], True)
         if ext > -margin:
-            best = minimize_scalar(lambda tt: -g(tt), bounds=(a, b), method="bounded",
-                                   options={"xatol": 1e-6 * (b - a)})
+            best = minimize_scalar(
+                lambda tt: -g(tt), bounds=(a, b), method="bounded", options={"xatol": 1e-6 * (b - a)}
+            )
             if -best.fun > 0:
                 tm = float(best.x)
                 return float(brentq(g, a, tm, xtol=1e-16, rtol=1e-14)) if deltas[i] < 0 else tm

@@ -13,9 +13,9 @@ import dataclasses
 import math
 
 import numpy as np
-from clearance.reference.system import ReferenceSystem
 
 from clearance.model import Clearance, Joint, JointType, Link
+from clearance.reference.system import ReferenceSystem
 
 __all__ = ["journal_in_bearing"]
 

@@ -22,9 +22,10 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy import integrate
+
 from clearance.reference.events import find_mode_change, gap
 from clearance.reference.system import ReferenceSystem, SingularConstraintsError
-from scipy import integrate
 
 __all__ = ["Trajectory", "IntegrationFailure", "integrate_system", "METHODS"]
 
@@ -175,8 +176,9 @@ def integrate_system(
             except SingularConstraintsError as exc:
                 raise fail(str(exc), solver.t, None) from None
             if solver.status == "failed":
-                raise fail(f"the {method} solver failed at t = {solver.t:.9g} s ({message})",
-                           solver.t, _deepest(system, geo))
+                raise fail(
+                    f"the {method} solver failed at t = {solver.t:.9g} s ({message})", solver.t, _deepest(system, geo)
+                )
             traj.n_steps += 1
             t0s, t1s, y1 = solver.t_old, solver.t, solver.y
             if not np.all(np.isfinite(y1)):
@@ -219,7 +221,10 @@ def integrate_system(
                     cj = system.contacts[k]
                     raise fail(
                         f"penetration {delta:.3g} m at joint '{cj.name}' exceeds the limit "
-                        f"{limits[k]:.3g} m at t = {t:.9g} s", t, cj.name)
+                        f"{limits[k]:.3g} m at t = {t:.9g} s",
+                        t,
+                        cj.name,
+                    )
             if projection and system.n_constraints and not restart:
                 z, zd = y[:nq], y[nq : 2 * nq]
                 phi, _, phit = system.rows.evaluate(t, z.tolist())

@@ -18,10 +18,10 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
-from clearance.reference.integrator import Trajectory
-from clearance.reference.system import ReferenceSystem
 
 from clearance.kinematics import output_kinematics
+from clearance.reference.integrator import Trajectory
+from clearance.reference.system import ReferenceSystem
 from clearance.results import JointResult, SimulationResult
 
 __all__ = ["assemble_result"]
@@ -41,8 +41,7 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
     torque = np.empty((n, nd))
     closure = np.empty(n)
     for i in range(n):
-        ev = system.evaluate(float(traj.times[i]), traj.z[i].tolist(), traj.zd[i].tolist(),
-                             traj.vin[i].tolist())
+        ev = system.evaluate(float(traj.times[i]), traj.z[i].tolist(), traj.zd[i].tolist(), traj.vin[i].tolist())
         zdd[i] = ev.zdd
         if nc:
             cres[i] = ev.contacts
@@ -80,8 +79,11 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
     if traj.work is not None:
         kin, pot, grav = system.energy(traj.z, traj.zd)
         meta["drive_work"] = traj.work.tolist()
-        meta["energy"] = {"kinetic": kin.tolist(), "contact_potential": pot.tolist(),
-                          "gravity_potential": grav.tolist()}
+        meta["energy"] = {
+            "kinetic": kin.tolist(),
+            "contact_potential": pot.tolist(),
+            "gravity_potential": grav.tolist(),
+        }
     meta["max_closure_violation"] = float(closure.max()) if n else 0.0
     return SimulationResult(
         times=np.array(traj.times, dtype=float),

@@ -13,7 +13,10 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+
+from clearance.checks import positive
 from clearance.contact_calibration.laws import MIN_APPROACH_SPEED, STIFFNESS_FORMULA
+from clearance.model import DriveKind, Mechanism
 from clearance.reference.integrator import (
     METHODS,
     IntegrationFailure,
@@ -22,8 +25,6 @@ from clearance.reference.integrator import (
 )
 from clearance.reference.output import assemble_result
 from clearance.reference.system import ReferenceSystem
-
-from clearance.model import DriveKind, Mechanism
 from clearance.results import SimulationResult
 from clearance.version import __version__
 
@@ -58,25 +59,16 @@ class ReferenceSolverError(RuntimeError):
         joint: clearance joint concerned, or None.
     """
 
-    def __init__(self, message: str, partial: SimulationResult | None, *, time: float,
-                 joint: str | None) -> None:
+    def __init__(self, message: str, partial: SimulationResult | None, *, time: float, joint: str | None) -> None:
         super().__init__(message)
         self.partial, self.time, self.joint = partial, time, joint
 
 
-def _check_positive(name: str, value: Any, unit: str) -> float:
-    if isinstance(value, bool) or not isinstance(value, (int, float, np.floating, np.integer)):
-        raise TypeError(f"{name} must be a number (got {value!r})")
-    v = float(value)
-    if not (math.isfinite(v) and v > 0):
-        raise ValueError(f"{name} must be > 0 and finite (got {value!r} {unit})")
-    return v
-
-
 def _scales(system: ReferenceSystem, zd0: np.ndarray) -> tuple[float, float, float]:
     """(length L [m], link size ell [m], angular rate Omega [1/s]) that scale tolerances."""
-    ell = max([math.hypot(px - lk.com[0], py - lk.com[1]) for lk in system.links
-               for px, py in lk.points.values()] + [1e-3])
+    ell = max(
+        [math.hypot(px - lk.com[0], py - lk.com[1]) for lk in system.links for px, py in lk.points.values()] + [1e-3]
+    )
     length = min([cj.c for cj in system.contacts], default=1e-3 * ell)
     rates = [abs(d.evaluate(0.0)[1]) for d in system.drives if d.kind is not DriveKind.TORQUE]
     vmax = float(np.max(np.abs(zd0))) if len(zd0) else 0.0
@@ -140,11 +132,11 @@ def simulate_system(
         TypeError, ValueError: bad arguments (checked before integrating).
         ReferenceSolverError: the run failed; ``.partial`` holds the result so far.
     """
-    duration = _check_positive("duration", duration, "s")
-    output_interval = _check_positive("output_interval", output_interval, "s")
+    duration = positive("duration", duration, "s")
+    output_interval = positive("output_interval", output_interval, "s")
     if output_interval > duration:
         raise ValueError(f"output_interval ({output_interval:g} s) must not exceed duration ({duration:g} s)")
-    rtol = _check_positive("rtol", rtol, "")
+    rtol = positive("rtol", rtol, "")
     if not 1e-13 <= rtol <= 1e-3:
         raise ValueError(f"rtol must be in [1e-13, 1e-3] (got {rtol!r})")
     if method not in METHODS:
@@ -172,7 +164,7 @@ def simulate_system(
     if max_penetration is None:
         limits = [0.05 * cj.rb for cj in system.contacts]
     else:
-        limits = [_check_positive("max_penetration", max_penetration, "m")] * len(system.contacts)
+        limits = [positive("max_penetration", max_penetration, "m")] * len(system.contacts)
     if stab is not Stabilisation.BAUMGARTE and (system.alpha or system.beta):
         import copy
 
@@ -188,8 +180,17 @@ def simulate_system(
     bar, cb = _progress(progress, duration, system.name)
     try:
         traj = integrate_system(
-            system, z0, zd0, duration, output_interval=output_interval, rtol=rtol, atol=atol_v,
-            method=method, projection=proj, track_work=track_work, max_penetration=limits,
+            system,
+            z0,
+            zd0,
+            duration,
+            output_interval=output_interval,
+            rtol=rtol,
+            atol=atol_v,
+            method=method,
+            projection=proj,
+            track_work=track_work,
+            max_penetration=limits,
             progress=cb,
         )
         failure = None
@@ -198,21 +199,31 @@ def simulate_system(
     finally:
         if bar is not None:
             bar.close()
-    settings = dict(method=method, rtol=rtol, atol=atol_v.tolist(), stabilisation=stab.value,
-                    output_interval=output_interval, duration=duration, max_penetration=limits)
+    settings = dict(
+        method=method,
+        rtol=rtol,
+        atol=atol_v.tolist(),
+        stabilisation=stab.value,
+        output_interval=output_interval,
+        duration=duration,
+        max_penetration=limits,
+    )
     result = to_result(system, traj, settings) if len(traj.times) else None
     if failure is not None:
         remedy = (
             "check the contact parameters and the drive speed, or raise max_penetration"
-            if "penetration" in str(failure) else
-            "check the mechanism for a singular (dead-centre) position" if "singular" in str(failure)
+            if "penetration" in str(failure)
+            else "check the mechanism for a singular (dead-centre) position"
+            if "singular" in str(failure)
             else "try rtol=1e-8 or method='Radau'"
         )
         raise ReferenceSolverError(
             f"reference run of '{system.name}' failed at t = {failure.time:.9g} s"
             f"{f' (joint {failure.joint!r})' if failure.joint else ''}: {failure}. Remedy: {remedy}. "
             "The result computed so far is attached as .partial.",
-            result, time=failure.time, joint=failure.joint,
+            result,
+            time=failure.time,
+            joint=failure.joint,
         )
     return result
 
@@ -264,16 +275,29 @@ def run_reference(
         ReferenceSolverError: the run failed; ``.partial`` holds the result so far.
     """
     system = ReferenceSystem(
-        mechanism, baumgarte=baumgarte, min_approach_speed=min_approach_speed,
-        friction_v0=friction_v0, friction_v1=friction_v1, impact_c_max=impact_c_max,
+        mechanism,
+        baumgarte=baumgarte,
+        min_approach_speed=min_approach_speed,
+        friction_v0=friction_v0,
+        friction_v1=friction_v1,
+        impact_c_max=impact_c_max,
         impact_d_max=impact_d_max,
     )
-    _check_positive("duration", duration, "s")
+    positive("duration", duration, "s")
     q0, qd0 = system.initial_state()
     return simulate_system(
-        system, q0, qd0, duration, output_interval=output_interval, rtol=rtol, atol=atol,
-        method=method, stabilisation=stabilisation, max_penetration=max_penetration,
-        track_work=track_work, progress=progress,
+        system,
+        q0,
+        qd0,
+        duration,
+        output_interval=output_interval,
+        rtol=rtol,
+        atol=atol,
+        method=method,
+        stabilisation=stabilisation,
+        max_penetration=max_penetration,
+        track_work=track_work,
+        progress=progress,
     )
 
 

@@ -24,19 +24,23 @@ from collections.abc import Sequence
 from typing import Any, NamedTuple
 
 import numpy as np
-from clearance.contact_calibration.laws import MIN_APPROACH_SPEED
-from clearance.reference.constraints import ConstraintRows
-from clearance.reference.contact import ContactJoint, contact_joints, evaluate_contact
 from scipy.linalg.lapack import dposv
 
+from clearance.contact_calibration.laws import MIN_APPROACH_SPEED
 from clearance.kinematics import assemble, velocities
 from clearance.model import DriveKind, Joint, Link, Mechanism, MotionLaw
+from clearance.reference.constraints import ConstraintRows
+from clearance.reference.contact import ContactJoint, contact_joints, evaluate_contact
 
 __all__ = ["ReferenceSystem", "SingularConstraintsError", "Evaluation"]
 
 _DEFAULTS: dict[str, Any] = dict(
-    baumgarte=(5.0, 5.0), min_approach_speed=MIN_APPROACH_SPEED, friction_v0=1e-4, friction_v1=1e-3,
-    impact_c_max=None, impact_d_max=None,
+    baumgarte=(5.0, 5.0),
+    min_approach_speed=MIN_APPROACH_SPEED,
+    friction_v0=1e-4,
+    friction_v1=1e-3,
+    impact_c_max=None,
+    impact_d_max=None,
 )
 
 
@@ -98,8 +102,7 @@ class ReferenceSystem:
     def __init__(self, mechanism: Mechanism, **options: Any) -> None:
         if not isinstance(mechanism, Mechanism):
             raise TypeError(f"mechanism must be a Mechanism (got {type(mechanism).__name__})")
-        self._build(mechanism.links, mechanism.joints, mechanism.drives, mechanism.ground,
-                    mechanism.gravity, options)
+        self._build(mechanism.links, mechanism.joints, mechanism.drives, mechanism.ground, mechanism.gravity, options)
         self.mechanism: Mechanism | None = mechanism
         self.name = mechanism.name
 
@@ -190,8 +193,13 @@ class ReferenceSystem:
         self.drives = self.rows.drives
         self.drive_names = [d.name for d in self.drives]
         self.contacts: list[ContactJoint] = contact_joints(
-            joints, index, rel, v0=float(o["friction_v0"]), v1=float(o["friction_v1"]),
-            c_max=o["impact_c_max"], d_max=o["impact_d_max"],
+            joints,
+            index,
+            rel,
+            v0=float(o["friction_v0"]),
+            v1=float(o["friction_v1"]),
+            c_max=o["impact_c_max"],
+            d_max=o["impact_d_max"],
         )
         self.contact_names = [c.name for c in self.contacts]
         self._torque = [(d.ia, d.ib, d.torque) for d in self.drives if d.kind is DriveKind.TORQUE]
@@ -252,16 +260,18 @@ class ReferenceSystem:
         if any(d.kind is DriveKind.TORQUE for d in mech.drives):
             # hold torque-driven joints at their start angle, at rest, for the assembly
             held = MotionLaw(0.0, period=1.0)
-            mech = dataclasses.replace(mech, drives=tuple(
-                dataclasses.replace(d, kind=DriveKind.MOTION_LAW, motion=held)
-                if d.kind is DriveKind.TORQUE else d for d in mech.drives))
+            mech = dataclasses.replace(
+                mech,
+                drives=tuple(
+                    dataclasses.replace(d, kind=DriveKind.MOTION_LAW, motion=held) if d.kind is DriveKind.TORQUE else d
+                    for d in mech.drives
+                ),
+            )
         q = assemble(mech, 0.0)
         return q, velocities(mech, q, 0.0)
 
     # -- dynamics ----------------------------------------------------------------------------
-    def evaluate(
-        self, t: float, zl: Sequence[float], zdl: Sequence[float], vin: Sequence[float]
-    ) -> Evaluation:
+    def evaluate(self, t: float, zl: Sequence[float], zdl: Sequence[float], vin: Sequence[float]) -> Evaluation:
         """Solve the equations of motion at one state.
 
         Args:
@@ -289,8 +299,9 @@ class ReferenceSystem:
             if r[11] != 0.0:
                 if not math.isfinite(r[11]):  # a rejected trial stage far outside the physics
                     nan = np.full(self.nq, math.nan)
-                    return Evaluation(nan, np.full(self.n_constraints, math.nan), [], cres,
-                                      [math.nan] * len(self.drives))
+                    return Evaluation(
+                        nan, np.full(self.n_constraints, math.nan), [], cres, [math.nan] * len(self.drives)
+                    )
                 i, k = cj.ij, cj.ib
                 if i >= 0:
                     q[3 * i] += r[7]
@@ -350,8 +361,9 @@ class ReferenceSystem:
             out[2 * nq :] = [tau * self.rate(zdl, k) for k, tau in enumerate(ev.drive_torque)]
         return out
 
-    def project(self, t: float, z: np.ndarray, zd: np.ndarray, *, tol: float = 1e-14,
-                max_iter: int = 5) -> tuple[np.ndarray, np.ndarray]:
+    def project(
+        self, t: float, z: np.ndarray, zd: np.ndarray, *, tol: float = 1e-14, max_iter: int = 5
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Mass-weighted projection of (z, zd) onto Phi = 0 and Phi_dot = 0.
 
         Args:
@@ -395,9 +407,9 @@ class ReferenceSystem:
             grav -= lk.mass * (gx * z[..., 3 * i] + gy * z[..., 3 * i + 1])
         pot = np.zeros(z.shape[:-1])
         for cj in self.contacts:
-            delta = np.array([
-                evaluate_contact(cj, zi, zi, 0.0)[4] for zi in z.reshape(-1, self.nq).tolist()
-            ]).reshape(z.shape[:-1])
+            delta = np.array([evaluate_contact(cj, zi, zi, 0.0)[4] for zi in z.reshape(-1, self.nq).tolist()]).reshape(
+                z.shape[:-1]
+            )
             n = cj.exponent
             pot += cj.stiffness * np.maximum(delta, 0.0) ** (n + 1) / (n + 1)
         return kin, pot, grav

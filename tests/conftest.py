@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import pytest
+
 from clearance.builders import slider_crank
 
 

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy.integrate import solve_ivp
+
 from clearance.analysis.chaos.poincare import (
     Regime,
     classify_poincare,
@@ -12,7 +14,6 @@ from clearance.analysis.chaos.poincare import (
     map_divergence,
     poincare_section,
 )
-from scipy.integrate import solve_ivp
 
 W = 1.2  # forcing frequency of the double-well Duffing oscillator (Guckenheimer & Holmes)
 T = 2 * np.pi / W

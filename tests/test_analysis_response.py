@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from scipy import stats
+
 from clearance.analysis.metrics.response import (
     ContactMode,
     LagMethod,
@@ -17,8 +19,6 @@ from clearance.analysis.metrics.statistics import (
     deviation_statistics_from_arrays,
     per_cycle_mean_deviation,
 )
-from scipy import stats
-
 from clearance.results import JointResult, SimulationResult
 
 OMEGA = 2 * np.pi * 10.0  # 10 Hz drive of the synthetic results
@@ -125,9 +125,8 @@ def test_on_a_simulated_slider_crank(slow_pair):
 @pytest.fixture(scope="module")
 def slow_pair():
     """Slider-crank at 1000 rpm (T = 60 ms), 3 revolutions, 5 us step, 36 segments."""
-    from clearance.builders import rpm, slider_crank
-
     from clearance import ModelOptions, simulate
+    from clearance.builders import rpm, slider_crank
 
     m = slider_crank(crank_speed=rpm(1000.0))
     o = ModelOptions(timestep=5e-6, segments=36)

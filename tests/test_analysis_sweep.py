@@ -6,6 +6,7 @@ import functools
 import json
 
 import pytest
+
 from clearance.analysis.sweeps.sweep import (
     KeywordFactory,
     SweepEvaluation,
@@ -13,7 +14,6 @@ from clearance.analysis.sweeps.sweep import (
     run_sweep,
 )
 from clearance.builders import four_bar, rpm, slider_crank
-
 from clearance.options import ModelOptions
 from clearance.run.simulation import default_duration
 
@@ -25,8 +25,7 @@ DURATION = functools.partial(default_duration, revolutions=2.0)
 
 
 def _sweep(out, **kw):
-    return run_sweep(POINTS, MAKE, out_dir=out, duration=DURATION, options=OPTIONS, progress=False,
-                     max_workers=2, **kw)
+    return run_sweep(POINTS, MAKE, out_dir=out, duration=DURATION, options=OPTIONS, progress=False, max_workers=2, **kw)
 
 
 @pytest.fixture(scope="module")
@@ -55,8 +54,9 @@ def test_rows_hold_statistics_summary_and_poincare(full):
 def test_resumed_sweep_equals_uninterrupted(full, tmp_path):
     # one worker keeps two points in flight; the stop after the first also writes the
     # second if it had started, and submits no more
-    part = run_sweep(POINTS, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False,
-                     max_workers=1, stop_after=1)
+    part = run_sweep(
+        POINTS, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False, max_workers=1, stop_after=1
+    )
     assert not part.complete and part.new in (1, 2)
     assert len(list((tmp_path / "points").glob("*.json"))) == part.new
     rest = _sweep(tmp_path)
@@ -72,22 +72,38 @@ def test_resumed_sweep_equals_uninterrupted(full, tmp_path):
 def test_dask_executor_matches_process_pool(full, tmp_path):
     distributed = pytest.importorskip("dask.distributed")
     with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
-        out = run_sweep(POINTS, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS,
-                        progress=False, scheduler_address=cluster.scheduler_address)
+        out = run_sweep(
+            POINTS,
+            MAKE,
+            out_dir=tmp_path,
+            duration=DURATION,
+            options=OPTIONS,
+            progress=False,
+            scheduler_address=cluster.scheduler_address,
+        )
     assert out.complete
     assert out.csv_path.read_bytes() == full.csv_path.read_bytes()
 
 
 def test_errors_are_rows_and_other_sweeps_are_refused(tmp_path):
     bad = [{"radial_clearance": 0.5e-3, "rod_length": 0.01}]  # rod shorter than crank
-    out = run_sweep(bad, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False,
-                    executor=_Inline(), evaluation=SweepEvaluation(ideal=False))
+    out = run_sweep(
+        bad,
+        MAKE,
+        out_dir=tmp_path,
+        duration=DURATION,
+        options=OPTIONS,
+        progress=False,
+        executor=_Inline(),
+        evaluation=SweepEvaluation(ideal=False),
+    )
     row = load_rows(tmp_path)[0]
     assert out.complete and row["status"] == "error" and "rod_length" in row["error"]
     assert json.loads((tmp_path / "points" / "point_000000.json").read_text())["index"] == 0
     with pytest.raises(ValueError, match="different sweep"):
-        run_sweep(POINTS, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False,
-                  executor=_Inline())
+        run_sweep(
+            POINTS, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False, executor=_Inline()
+        )
     with pytest.raises(ValueError, match="stop_after"):
         run_sweep(POINTS, MAKE, out_dir=tmp_path / "x", stop_after=0, executor=_Inline())
 
@@ -98,15 +114,31 @@ BAD = [{"radial_clearance": c, "rod_length": 0.01} for c in (0.1e-3, 0.2e-3, 0.3
 def test_points_finishing_with_the_stop_are_written(tmp_path):
     # the inline executor finishes all three points before the first wait: they come back
     # in one batch, and the stop after the first must not drop the other two
-    out = run_sweep(BAD, MAKE, out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False,
-                    executor=_Inline(), max_workers=3, stop_after=1, evaluation=SweepEvaluation(ideal=False))
+    out = run_sweep(
+        BAD,
+        MAKE,
+        out_dir=tmp_path,
+        duration=DURATION,
+        options=OPTIONS,
+        progress=False,
+        executor=_Inline(),
+        max_workers=3,
+        stop_after=1,
+        evaluation=SweepEvaluation(ideal=False),
+    )
     assert out.new == 3 and out.complete
     assert [r["index"] for r in load_rows(tmp_path)] == [0, 1, 2]
 
 
 def test_resume_with_another_mechanism_factory_is_refused(tmp_path):
-    kw = dict(out_dir=tmp_path, duration=DURATION, options=OPTIONS, progress=False, executor=_Inline(),
-              evaluation=SweepEvaluation(ideal=False))
+    kw = dict(
+        out_dir=tmp_path,
+        duration=DURATION,
+        options=OPTIONS,
+        progress=False,
+        executor=_Inline(),
+        evaluation=SweepEvaluation(ideal=False),
+    )
     assert run_sweep(BAD, MAKE, **kw).new == 3
     other_builder = KeywordFactory(four_bar, fixed={"crank_speed": rpm(1000.0)})
     other_speed = KeywordFactory(slider_crank, fixed={"crank_speed": rpm(2000.0)})

@@ -6,6 +6,7 @@ from concurrent.futures import Future
 
 import numpy as np
 import pytest
+
 from clearance.analysis.sweeps.bifurcation import (
     BifurcationDiagram,
     bifurcation_from_rows,
@@ -20,7 +21,6 @@ from clearance.analysis.sweeps.criticality import (
 )
 from clearance.analysis.sweeps.sweep import KeywordFactory
 from clearance.builders import rpm, slider_crank
-
 from clearance.cli.rank import main_rank
 from clearance.cli.sweep import main_sweep
 from clearance.model import OutputKind
@@ -42,8 +42,17 @@ class _Inline:
 def test_bifurcation_sweep_and_figure(tmp_path):
     make = KeywordFactory(slider_crank, fixed={"crank_speed": rpm(1000.0)})
     values = [0.1e-3, 0.5e-3]
-    d = run_bifurcation(values, make, out_dir=tmp_path, quantity="rod_slider.ex", periods=4, sampled=2,
-                        options=OPTIONS, executor=_Inline(), progress=False)
+    d = run_bifurcation(
+        values,
+        make,
+        out_dir=tmp_path,
+        quantity="rod_slider.ex",
+        periods=4,
+        sampled=2,
+        options=OPTIONS,
+        executor=_Inline(),
+        progress=False,
+    )
     np.testing.assert_array_equal(d.values, values)
     assert d.quantity == "rod_slider.ex" and d.errors == ("", "")
     # sections at t = 2T and 3T: the run ends one step before 4T
@@ -61,8 +70,13 @@ def test_bifurcation_sweep_and_figure(tmp_path):
 
 def test_bifurcation_from_rows_marks_failed_points():
     rows = [
-        {"index": 0, "point": {"c": 1.0}, "status": "ok", "error": "",
-         "poincare": {"quantities": ["q"], "points": [[1.0], [2.0]], "regime": "periodic"}},
+        {
+            "index": 0,
+            "point": {"c": 1.0},
+            "status": "ok",
+            "error": "",
+            "poincare": {"quantities": ["q"], "points": [[1.0], [2.0]], "regime": "periodic"},
+        },
         {"index": 1, "point": {"c": 2.0}, "status": "error", "error": "TimeStepError: x"},
     ]
     d = bifurcation_from_rows(rows, "c")
@@ -74,8 +88,16 @@ def test_bifurcation_from_rows_marks_failed_points():
 
 def test_criticality_candidates_and_sweep(tmp_path):
     assert criticality_candidates(slider_crank(clearance_at=())) == ["crank_rod", "rod_slider"]
-    r = run_criticality(ClearanceAtJoint(slider_crank), clearances=[0.5e-3], speeds=[rpm(1000.0)], periods=3,
-                        out_dir=tmp_path, options=OPTIONS, executor=_Inline(), progress=False)
+    r = run_criticality(
+        ClearanceAtJoint(slider_crank),
+        clearances=[0.5e-3],
+        speeds=[rpm(1000.0)],
+        periods=3,
+        out_dir=tmp_path,
+        options=OPTIONS,
+        executor=_Inline(),
+        progress=False,
+    )
     assert {s.joint for s in r.scores} == {"crank_rod", "rod_slider"}
     assert [s.rank for s in r.scores] == [1, 2]
     for s in r.scores:
@@ -93,8 +115,16 @@ def test_criticality_candidates_and_sweep(tmp_path):
     assert fig.axes[0].get_ylabel() == "mean deviation of slider_x / radial clearance [-]"
     assert (tmp_path / "crit.png").stat().st_size > 5000
     with pytest.raises(ValueError, match="output must be one of .*slider_x"):
-        run_criticality(ClearanceAtJoint(slider_crank), clearances=[0.5e-3], speeds=[rpm(1000.0)], periods=3,
-                        output="crank_angle", out_dir=tmp_path / "x", executor=_Inline(), progress=False)
+        run_criticality(
+            ClearanceAtJoint(slider_crank),
+            clearances=[0.5e-3],
+            speeds=[rpm(1000.0)],
+            periods=3,
+            output="crank_angle",
+            out_dir=tmp_path / "x",
+            executor=_Inline(),
+            progress=False,
+        )
 
 
 def test_score_unit_follows_the_output_kind():
@@ -111,8 +141,13 @@ def test_score_unit_follows_the_output_kind():
 
 
 def _row(i, joint, c, cycles):
-    return {"index": i, "status": "ok", "error": "", "point": {"joint": joint, "clearance": c, "speed": 100.0},
-            "per_cycle_mean_deviation": cycles}
+    return {
+        "index": i,
+        "status": "ok",
+        "error": "",
+        "point": {"joint": joint, "clearance": c, "speed": 100.0},
+        "per_cycle_mean_deviation": cycles,
+    }
 
 
 def test_rank_joints_scores_and_confidence():
@@ -138,25 +173,45 @@ def test_rank_joints_scores_and_confidence():
 
 
 def test_report_writes_markdown_and_figures(tmp_path):
-    from clearance.analysis.figures.report import write_report
-
     from clearance import simulate
+    from clearance.analysis.figures.report import write_report
 
     m = slider_crank(crank_speed=rpm(1000.0))
     res, ideal = simulate(m, options=OPTIONS), simulate(m.ideal_twin(), options=OPTIONS)
-    diag = BifurcationDiagram("radial_clearance", "rod_slider.ex", np.array([1e-4, 2e-4]),
-                              (np.array([1e-5, 2e-5]), np.zeros(0)), ("periodic", "error"), ("", "boom"))
+    diag = BifurcationDiagram(
+        "radial_clearance",
+        "rod_slider.ex",
+        np.array([1e-4, 2e-4]),
+        (np.array([1e-5, 2e-5]), np.zeros(0)),
+        ("periodic", "error"),
+        ("", "boom"),
+    )
     ranking = rank_joints([_row(0, "a", 1e-4, [0.5e-4, 0.6e-4]), _row(1, "b", 1e-4, [0.2e-4, 0.3e-4])])
     # figures of an earlier report into the same folder (a mechanism with more joints)
     for stale in ("phase_4.png", "poincare_2.png"):
         (tmp_path / stale).write_bytes(b"")
     path = write_report(tmp_path, res, ideal, bifurcation=diag, ranking=ranking)
     text = path.read_text()
-    for heading in ("Response against the ideal", "Deviation statistics", "Contact at the clearance joints",
-                    "Poincaré sections", "Bifurcation diagram", "Joint criticality"):
+    for heading in (
+        "Response against the ideal",
+        "Deviation statistics",
+        "Contact at the clearance joints",
+        "Poincaré sections",
+        "Bifurcation diagram",
+        "Joint criticality",
+    ):
         assert heading in text
-    for png in ("response_vs_ideal", "deviation", "contact_force", "contact_modes", "orbit_rod_slider",
-                "phase_0", "poincare_1", "bifurcation", "criticality"):
+    for png in (
+        "response_vs_ideal",
+        "deviation",
+        "contact_force",
+        "contact_modes",
+        "orbit_rod_slider",
+        "phase_0",
+        "poincare_1",
+        "bifurcation",
+        "criticality",
+    ):
         assert (tmp_path / f"{png}.png").exists() and f"({png}.png)" in text
     # sections: the output's phase portrait and rod_slider's eccentricity, nothing older
     assert "phase_4.png" not in text and "poincare_2.png" not in text
@@ -164,16 +219,49 @@ def test_report_writes_markdown_and_figures(tmp_path):
 
 def test_cli_sweep_and_rank(tmp_path, capsys):
     common = ["--rpm", "1000", "--timestep-us", "5", "--segments", "36", "--workers", "1", "--no-progress"]
-    rc = main_sweep(["--points", "2", "--start", "0.2", "--stop", "0.5", "--periods", "3", "--sampled", "1",
-                     "--out", str(tmp_path / "s"), *common])
+    rc = main_sweep(
+        [
+            "--points",
+            "2",
+            "--start",
+            "0.2",
+            "--stop",
+            "0.5",
+            "--periods",
+            "3",
+            "--sampled",
+            "1",
+            "--out",
+            str(tmp_path / "s"),
+            *common,
+        ]
+    )
     assert rc == 0 and (tmp_path / "s" / "bifurcation.png").exists() and (tmp_path / "s" / "sweep.csv").exists()
-    rc = main_rank(["--clearances-mm", "0.5", "--joints", "rod_slider", "--periods", "3",
-                    "--out", str(tmp_path / "r"), *common])
+    rc = main_rank(
+        ["--clearances-mm", "0.5", "--joints", "rod_slider", "--periods", "3", "--out", str(tmp_path / "r"), *common]
+    )
     assert rc == 0 and "rod_slider" in (tmp_path / "r" / "ranking.md").read_text()
     assert "rod_slider" in capsys.readouterr().out
     # over drive speed: 1000 and 2000 rpm given in rpm, stored in rad/s (SI inside)
-    rc = main_sweep(["--parameter", "speed", "--points", "2", "--start", "1000", "--stop", "2000", "--periods", "3",
-                     "--sampled", "1", "--out", str(tmp_path / "v"), *common[2:]])
+    rc = main_sweep(
+        [
+            "--parameter",
+            "speed",
+            "--points",
+            "2",
+            "--start",
+            "1000",
+            "--stop",
+            "2000",
+            "--periods",
+            "3",
+            "--sampled",
+            "1",
+            "--out",
+            str(tmp_path / "v"),
+            *common[2:],
+        ]
+    )
     assert rc == 0 and (tmp_path / "v" / "bifurcation.png").exists()
     from clearance.analysis.sweeps.sweep import load_rows
 
@@ -194,8 +282,25 @@ def test_cli_refuses_unknown_quantity_and_reports_failed_points(tmp_path, capsys
     rc = main_sweep(["--timestep-us", "1000", "--points", "2", "--out", str(tmp_path / "f"), *common])
     err = capsys.readouterr().err
     assert rc == 1 and "2 of 2 points failed" in err and "TimeStepError" in err and "sweep.csv" in err
-    rc = main_rank(["--timestep-us", "1000", "--clearances-mm", "0.5", "--rpm", "1000", "--joints", "rod_slider",
-                    "--periods", "3", "--workers", "1", "--no-progress", "--out", str(tmp_path / "r")])
+    rc = main_rank(
+        [
+            "--timestep-us",
+            "1000",
+            "--clearances-mm",
+            "0.5",
+            "--rpm",
+            "1000",
+            "--joints",
+            "rod_slider",
+            "--periods",
+            "3",
+            "--workers",
+            "1",
+            "--no-progress",
+            "--out",
+            str(tmp_path / "r"),
+        ]
+    )
     assert rc == 1 and "1 of 1 points failed" in capsys.readouterr().err
     assert main_rank(["--joints", "no_such", "--out", str(tmp_path / "j")]) == 2
     assert "['crank_rod', 'rod_slider']" in capsys.readouterr().err
@@ -205,8 +310,19 @@ def test_cli_sweeps_and_ranks_the_press(tmp_path, monkeypatch, capsys):
     """The press's speed keyword is crank2_speed; one short point each (about 4 s)."""
     monkeypatch.chdir(tmp_path)
     # 90 rpm = 3 pi rad/s (T = 0.67 s), the top of the press's speed range; 10 us steps
-    common = ["--mechanism", "seven_bar_press", "--rpm", "90", "--timestep-us", "10", "--segments", "36",
-              "--workers", "1", "--no-progress"]
+    common = [
+        "--mechanism",
+        "seven_bar_press",
+        "--rpm",
+        "90",
+        "--timestep-us",
+        "10",
+        "--segments",
+        "36",
+        "--workers",
+        "1",
+        "--no-progress",
+    ]
     rc = main_sweep(["--points", "1", "--start", "0.5", "--stop", "0.5", "--periods", "2", "--sampled", "1", *common])
     out = tmp_path / "clearance-sweep-seven_bar_press"  # default folder named after the mechanism
     assert rc == 0 and (out / "bifurcation.png").exists(), capsys.readouterr().err
@@ -221,12 +337,14 @@ def _analysis_and_cli_modules() -> list[str]:
     import pkgutil
 
     import clearance.analysis
-
     import clearance.cli
 
-    return [m.name for pkg in (clearance.analysis, clearance.cli)
-            for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + ".")
-            if not m.ispkg and not m.name.endswith("__main__")]  # __main__ runs the command on import
+    return [
+        m.name
+        for pkg in (clearance.analysis, clearance.cli)
+        for m in pkgutil.walk_packages(pkg.__path__, pkg.__name__ + ".")
+        if not m.ispkg and not m.name.endswith("__main__")
+    ]  # __main__ runs the command on import
 
 
 @pytest.mark.parametrize("module", _analysis_and_cli_modules())

@@ -25,6 +25,7 @@ FLOORS: dict[str, str] = {
     "clearance.kinematics": "data model",
     "clearance.units": "data model",
     "clearance.version": "data model",
+    "clearance.checks": "data model",
     "clearance.loads": "inverse dynamics",
     "clearance.builders": "builders",
     "clearance.mjcf": "mjcf",
@@ -40,8 +41,17 @@ FLOORS: dict[str, str] = {
 """Module (or package prefix) -> floor; the longest prefix wins. `clearance` alone is the
 package's ``__init__``: its front door."""
 
-_BELOW_CLI = {"data model", "inverse dynamics", "builders", "mjcf", "contact laws", "contact", "reference", "run",
-              "analysis"}
+_BELOW_CLI = {
+    "data model",
+    "inverse dynamics",
+    "builders",
+    "mjcf",
+    "contact laws",
+    "contact",
+    "reference",
+    "run",
+    "analysis",
+}
 
 ALLOWED: dict[str, set[str]] = {
     "data model": set(),
@@ -131,12 +141,15 @@ def test_no_import_goes_up_the_floors():
     assert not bad, "imports the map forbids (docs/architecture.md):\n" + "\n".join(bad)
 
 
-@pytest.mark.parametrize(("source", "module", "expected"), [
-    ("from clearance.cli import main", "clearance.analysis.x", "clearance.cli"),
-    ("def f():\n    from clearance.run.simulation import simulate", "clearance.mjcf.x", "clearance.run.simulation"),
-    ("from ..builders import catalogue", "clearance.analysis.x", "clearance.builders.catalogue"),
-    ("import clearance.bench.scenarios", "clearance.run.x", "clearance.bench.scenarios"),
-])
+@pytest.mark.parametrize(
+    ("source", "module", "expected"),
+    [
+        ("from clearance.cli import main", "clearance.analysis.x", "clearance.cli"),
+        ("def f():\n    from clearance.run.simulation import simulate", "clearance.mjcf.x", "clearance.run.simulation"),
+        ("from ..builders import catalogue", "clearance.analysis.x", "clearance.builders.catalogue"),
+        ("import clearance.bench.scenarios", "clearance.run.x", "clearance.bench.scenarios"),
+    ],
+)
 def test_the_checker_sees_every_kind_of_import(source, module, expected):
     """A function-level, relative or plain import that goes up is found (the check can fail)."""
     known = {"clearance.builders.catalogue", "clearance.run.simulation", "clearance.bench.scenarios", "clearance.cli"}

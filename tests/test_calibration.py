@@ -9,6 +9,7 @@ import warnings
 import mujoco
 import numpy as np
 import pytest
+
 from clearance.builders import slider_crank
 from clearance.contact_calibration import clearance_impact
 from clearance.contact_calibration.exact_ln import ExactLNContact, exact_ln_impact
@@ -27,7 +28,6 @@ from clearance.contact_calibration.store import (
 )
 from clearance.mjcf.probe import ring_scene
 from clearance.mjcf.spec import ring_geometry
-
 from clearance.model import ContactLaw, Material
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
 
@@ -82,8 +82,9 @@ def test_round_trip_reaches_stated_accuracy(fitted, joint, ring, options, monkey
     assert path2 == path
     assert again.parameters == result.parameters
     err, _, _ = evaluate(joint.clearance, ring, options, again.parameters, mass=MASS, speeds=SPEEDS)
-    stored = np.array([[r.peak_force_err, r.max_penetration_err, r.duration_err, r.restitution_err]
-                       for r in again.rows])
+    stored = np.array(
+        [[r.peak_force_err, r.max_penetration_err, r.duration_err, r.restitution_err] for r in again.rows]
+    )
     np.testing.assert_allclose(err.mean(axis=1), stored, rtol=0, atol=1e-9)
     for e in err.reshape(-1, 4):
         assert abs(e[0]) <= GOALS["peak_force"] and abs(e[1]) <= GOALS["max_penetration"]
@@ -95,16 +96,14 @@ def test_stability_is_checked(fitted, ring):
     # Fitted at h = 1 us: omega*h ~ 0.1 at 4x the fastest impact's penetration.
     assert result.stability.omega_h < 0.5
     with pytest.raises(CalibrationStabilityError, match=r"omega\*h = .* \(must be < 2\)"):
-        check_stability(ring, result.parameters, mass=MASS, timestep=1e-4,
-                        max_penetration=result.stability.penetration)
+        check_stability(ring, result.parameters, mass=MASS, timestep=1e-4, max_penetration=result.stability.penetration)
 
 
 @pytest.mark.parametrize("speed", [0.1, 5.0])
 def test_exact_ln_matches_impact_reference(joint, ring, options, speed):
     ref = clearance_impact(joint.clearance, mass=MASS, speed=speed)
     # Between two segments: the polygon's gap is largest there, exact LN must not see it.
-    imp = exact_ln_impact(joint.clearance, ring, options, mass=MASS, speed=speed,
-                          direction=math.pi / ring.segments)
+    imp = exact_ln_impact(joint.clearance, ring, options, mass=MASS, speed=speed, direction=math.pi / ring.segments)
     # 1 %: the exact-LN goal of the calibration issue (measured 0.05-0.5 %, the O(h) error
     # of the semi-implicit step with 45-95 steps per contact).
     assert imp.peak_force == pytest.approx(ref.peak_force, rel=0.01)
@@ -161,8 +160,7 @@ def test_corrupt_file_warns_and_is_rebuilt(joint, ring, options, damage):
     assert r2.parameters == r1.parameters
     with warnings.catch_warnings():
         warnings.simplefilter("error", CalibrationCacheWarning)
-        key = calibration_key(joint.clearance, ring, options, mass=MASS, mass_range=(MASS, MASS),
-                              speeds=speeds)
+        key = calibration_key(joint.clearance, ring, options, mass=MASS, mass_range=(MASS, MASS), speeds=speeds)
         assert load_calibration(key) is not None  # the rebuilt file is valid
 
 
@@ -198,8 +196,7 @@ def test_cache_key_changes_with_every_input(joint, ring, options, monkeypatch):
 
 def test_cache_key_ignores_last_bit_mass_differences(joint, ring, options):
     def path(m, mr):
-        return calibration_path(calibration_key(joint.clearance, ring, options, mass=m,
-                                                mass_range=mr, speeds=SPEEDS))
+        return calibration_path(calibration_key(joint.clearance, ring, options, mass=m, mass_range=mr, speeds=SPEEDS))
 
     m = 0.09325267705261375  # a cycle median as computed; the next float up differs in bit 52
     lo, hi = 0.09320979483785574, 0.09337884839246235
@@ -225,7 +222,6 @@ def test_unwritable_cache_warns_and_keeps_the_fit(joint, ring, options, tmp_path
 
 def test_prepare_calibrated_mode_uses_the_cache(default_mechanism, monkeypatch):
     from clearance.contact_calibration import fit
-
     from clearance.run.preparation import prepare
 
     opts = ModelOptions(contact_mode=ContactMode.CALIBRATED)
@@ -247,8 +243,9 @@ def test_cycle_effective_mass(default_prepared):
     from clearance.mjcf import effective_masses
 
     p = default_prepared
-    free = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12, lock_velocity_drives=False,
-                                along_load=False)["rod_slider"]
+    free = cycle_effective_mass(
+        p.model, p.built, p.mechanism, n_poses=12, lock_velocity_drives=False, along_load=False
+    )["rod_slider"]
     locked = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12, along_load=False)["rod_slider"]
     # Pose 0 is qpos0 and, without the drive lock, the direction median is the qpos0
     # estimate's: equal to round-off (1e-9 covers the pose mapping's 1e-12 residual).
@@ -266,11 +263,13 @@ def test_cycle_effective_mass(default_prepared):
     assert load.values[0] == pytest.approx(0.14, rel=1e-9)
     assert load.minimum <= load.median <= load.maximum
     assert p.sizing["rod_slider"].effective_mass == pytest.approx(  # the sizing's (36 poses) is this kind
-        cycle_effective_mass(p.model, p.built, p.mechanism)["rod_slider"].median, rel=1e-12)
+        cycle_effective_mass(p.model, p.built, p.mechanism)["rod_slider"].median, rel=1e-12
+    )
 
 
 def test_report_files(fitted, joint, ring, options, tmp_path, monkeypatch):
     import matplotlib
+
     from clearance.contact_calibration.report import calibration_report
 
     def no_switch(*args, **kwargs):
@@ -278,8 +277,9 @@ def test_report_files(fitted, joint, ring, options, tmp_path, monkeypatch):
 
     monkeypatch.setattr(matplotlib, "use", no_switch)
     result, path = fitted
-    files = calibration_report(result, joint.clearance, ring, options, out_dir=tmp_path,
-                               exact_ln=False, source=str(path))
+    files = calibration_report(
+        result, joint.clearance, ring, options, out_dir=tmp_path, exact_ln=False, source=str(path)
+    )
     assert sorted(p.name for p in tmp_path.iterdir()) == ["calibration.md", "calibration.png"]  # no temporaries
     text = files.markdown.read_text()
     assert "| v [m/s] |" in text and f"{result.parameters.stiffness:.6g}" in text
@@ -305,13 +305,14 @@ def test_exact_ln_in_the_full_mechanism(default_prepared):
     p = default_prepared
     model = copy.copy(p.model)  # ExactLNContact raises the pair margins in place
     j = p.mechanism.clearance_joints[0]
-    contact = ExactLNContact(model, j.clearance, p.built.rings[j.name],
-                             journal_geom=f"{j.name}__journal", bearing_site=f"{j.name}__bearing")
+    contact = ExactLNContact(
+        model, j.clearance, p.built.rings[j.name], journal_geom=f"{j.name}__journal", bearing_site=f"{j.name}__bearing"
+    )
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
     run = step_exact_ln(model, data, [contact], 2500)  # 2.5 ms: first impacts
     adr = model.sensor_adr[model.sensor(f"{j.name}__force").id]
-    sensed = np.linalg.norm(run.sensordata[:, adr:adr + 3], axis=1)
+    sensed = np.linalg.norm(run.sensordata[:, adr : adr + 3], axis=1)
     imposed = run.force[:, 0]
     assert imposed.max() > 1e4  # an impact happened (the ideal joint load is ~1.3 kN)
     assert np.all((imposed > 0) == (run.penetration[:, 0] > 0))  # force only in contact
@@ -327,8 +328,9 @@ def test_concurrent_writers_leave_a_valid_file(fitted, joint, ring, options):
     from clearance.contact_calibration.store import save_calibration
 
     result, _ = fitted
-    key = calibration_key(joint.clearance, ring, options, mass=MASS, mass_range=(MASS, MASS),
-                          speeds=np.array([9.0, 10.0]))
+    key = calibration_key(
+        joint.clearance, ring, options, mass=MASS, mass_range=(MASS, MASS), speeds=np.array([9.0, 10.0])
+    )
     with ThreadPoolExecutor(8) as pool:
         paths = list(pool.map(lambda _: save_calibration(key, result), range(32)))
     assert len(set(paths)) == 1

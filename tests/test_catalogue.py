@@ -10,17 +10,22 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from clearance.builders import CATALOGUE, build, names
 from clearance.builders.catalogue import get
-
 from clearance.kinematics import solve_kinematics
 from clearance.model import DriveKind, JointType
 
 NAMES = list(CATALOGUE)
 DOCS = Path(__file__).resolve().parents[1] / "docs" / "catalogue"
 # links / joints / drives of each mechanism (issue: eight- and ten-bar 1 DOF, the press 2 DOF)
-SIZES = {"slider_crank": (4, 4, 1), "four_bar": (4, 4, 1), "eight_bar": (8, 10, 1), "ten_bar": (10, 13, 1),
-         "seven_bar_press": (7, 8, 2)}
+SIZES = {
+    "slider_crank": (4, 4, 1),
+    "four_bar": (4, 4, 1),
+    "eight_bar": (8, 10, 1),
+    "ten_bar": (10, 13, 1),
+    "seven_bar_press": (7, 8, 2),
+}
 
 
 @pytest.fixture(scope="module")
@@ -31,8 +36,17 @@ def built():
 def test_registry_lists_the_issue_mechanisms():
     assert names() == tuple(CATALOGUE)
     assert set(names()) == {
-        "slider_crank", "four_bar", "watt_six_bar", "watt_six_bar_slider_1", "watt_six_bar_slider_2",
-        "stephenson_i", "stephenson_i_slider", "stephenson_ii_1", "stephenson_ii_2", "eight_bar", "ten_bar",
+        "slider_crank",
+        "four_bar",
+        "watt_six_bar",
+        "watt_six_bar_slider_1",
+        "watt_six_bar_slider_2",
+        "stephenson_i",
+        "stephenson_i_slider",
+        "stephenson_ii_1",
+        "stephenson_ii_2",
+        "eight_bar",
+        "ten_bar",
         "seven_bar_press",
     }
     with pytest.raises(KeyError, match="unknown mechanism 'nine_bar'.*catalogue has"):
@@ -117,7 +131,6 @@ def test_start_angle_stays_on_the_branch(name):
 
 def test_press_drives_are_configurable():
     from clearance.builders import seven_bar_press
-
     from clearance.model import MotionLaw
 
     m = seven_bar_press(crank2_speed=2 * math.pi)
@@ -147,6 +160,7 @@ def test_linkage_plot_labels_every_joint_and_link(built):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+
     from clearance.analysis.figures.linkage_plot import plot_linkage
 
     m = built["ten_bar"]

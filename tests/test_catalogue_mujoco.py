@@ -15,9 +15,9 @@ import math
 
 import numpy as np
 import pytest
-from clearance.builders import CATALOGUE, four_bar, rpm
 
 from clearance import ModelOptions, simulate
+from clearance.builders import CATALOGUE, four_bar, rpm
 from clearance.kinematics import solve_kinematics
 
 SEGMENTS = 8
@@ -34,7 +34,7 @@ def _setup(name: str) -> tuple[dict, ModelOptions]:
     return {"crank_speed": rpm(1000)}, ModelOptions(timestep=STEP, segments=SEGMENTS)
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _contact():
     from clearance.run.preparation import prepare
 
@@ -42,7 +42,7 @@ def _contact():
     return p.contact["B"]
 
 
-@functools.lru_cache(maxsize=None)
+@functools.cache
 def _run(name: str, clearance_at: tuple[str, ...]):
     kwargs, options = _setup(name)
     m = CATALOGUE[name].builder(clearance_at=clearance_at, **kwargs)
@@ -77,8 +77,11 @@ def _sets(name: str) -> list[tuple[str, ...]]:
     return [(j,) for j in clearable] + [tuple(clearable)]
 
 
-@pytest.mark.parametrize("name,clearance_at", [(n, s) for n in CATALOGUE for s in [()] + _sets(n)],
-                         ids=lambda v: v if isinstance(v, str) else ("+".join(v) or "ideal"))
+@pytest.mark.parametrize(
+    "name,clearance_at",
+    [(n, s) for n in CATALOGUE for s in [()] + _sets(n)],
+    ids=lambda v: v if isinstance(v, str) else ("+".join(v) or "ideal"),
+)
 def test_runs_one_cycle_without_warnings(name, clearance_at):
     m, r = _run(name, clearance_at)
     period = max(d.period for d in m.drives)

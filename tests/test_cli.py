@@ -15,8 +15,19 @@ def test_run_writes_everything(tmp_path):
     # a short run (2 ms) of the default scenario keeps the test fast
     rc = main(["run", "--duration-ms", "2", "--out", str(out), "--no-progress"])
     assert rc == 0
-    for name in ("result.npz", "result.json", "ideal.npz", "summary.csv", "model.xml", "ideal_model.xml",
-                 "report.md", "response_vs_ideal.png", "deviation.png", "contact_force.png", "orbit_rod_slider.png"):
+    for name in (
+        "result.npz",
+        "result.json",
+        "ideal.npz",
+        "summary.csv",
+        "model.xml",
+        "ideal_model.xml",
+        "report.md",
+        "response_vs_ideal.png",
+        "deviation.png",
+        "contact_force.png",
+        "orbit_rod_slider.png",
+    ):
         assert (out / name).stat().st_size > 0, name
     rows = list(csv.DictReader((out / "summary.csv").open()))
     assert rows[0]["joint"] == "rod_slider" and float(rows[0]["peak_force"]) > 0
@@ -68,7 +79,6 @@ def test_rpm_sets_the_catalogue_mechanisms_driven_crank(tmp_path, monkeypatch):
     import math
 
     from clearance.builders import CATALOGUE
-
     from clearance.cli import options as cli_options
 
     built = []
@@ -115,7 +125,6 @@ def test_calibrate_writes_the_calibration_a_calibrated_run_reuses(tmp_path, monk
     from clearance.builders import slider_crank
     from clearance.contact_calibration import store
     from clearance.contact_calibration.store import cache_dir
-
     from clearance.options import ModelOptions
     from clearance.run.preparation import prepare
 
@@ -141,14 +150,24 @@ def test_calibrate_writes_the_calibration_a_calibrated_run_reuses(tmp_path, monk
     assert key["mass_range"] == pytest.approx(list(prepared.sizing["rod_slider"].effective_mass_range), rel=1e-8)
     assert key["mass_range"][0] < key["mass_range"][1]
     out = tmp_path / "run"
-    assert main(["run", "--contact-mode", "calibrated", "--duration-ms", "0.3", "--out", str(out), "--no-progress"]) == 0
+    assert (
+        main(["run", "--contact-mode", "calibrated", "--duration-ms", "0.3", "--out", str(out), "--no-progress"]) == 0
+    )
     assert len(fits) == 1, "clearance run --contact-mode calibrated refitted"
     meta = json.loads((out / "result.json").read_text())
     assert meta["contact"]["rod_slider"]["source"] == f"calibrated: {files[0]}"
 
 
-@pytest.mark.parametrize("flag,value", [("--segments", "36"), ("--timestep-us", "2"), ("--journal-geom", "capsule"),
-                                        ("--segment-geom", "box"), ("--contact-mode", "calibrated")])
+@pytest.mark.parametrize(
+    "flag,value",
+    [
+        ("--segments", "36"),
+        ("--timestep-us", "2"),
+        ("--journal-geom", "capsule"),
+        ("--segment-geom", "box"),
+        ("--contact-mode", "calibrated"),
+    ],
+)
 def test_reference_refuses_mujoco_numerics(flag, value, tmp_path, capsys):
     assert main(["reference", flag, value, "--duration-ms", "0.1", "--out", str(tmp_path), "--no-progress"]) == 2
     err = capsys.readouterr().err
@@ -170,12 +189,13 @@ def test_torque_driven_scenario_runs_and_refuses_revolutions(tmp_path, capsys):
     import dataclasses
 
     from clearance.builders import dump_scenario, slider_crank
-
     from clearance.model import Drive, DriveKind
 
     mech = slider_crank(gravity=9.81)
     drive = mech.drives[0]
-    torque_driven = dataclasses.replace(mech, drives=(Drive(drive.name, drive.joint, kind=DriveKind.TORQUE, torque=0.05),))
+    torque_driven = dataclasses.replace(
+        mech, drives=(Drive(drive.name, drive.joint, kind=DriveKind.TORQUE, torque=0.05),)
+    )
     path = tmp_path / "torque.toml"
     dump_scenario(torque_driven, path)
     out = tmp_path / "out"
@@ -183,8 +203,27 @@ def test_torque_driven_scenario_runs_and_refuses_revolutions(tmp_path, capsys):
     assert "--revolutions 2: mechanism 'slider_crank' is driven by torques alone" in capsys.readouterr().err
     assert not out.exists()  # refused before any work
     # 1 ms at 20 us: a short, cheap run; the point is that every output is written
-    assert main(["run", "--scenario", str(path), "--duration-ms", "1", "--timestep-us", "20", "--segments", "72",
-                 "--contact-mode", "nominal", "--out", str(out), "--no-progress"]) == 0
+    assert (
+        main(
+            [
+                "run",
+                "--scenario",
+                str(path),
+                "--duration-ms",
+                "1",
+                "--timestep-us",
+                "20",
+                "--segments",
+                "72",
+                "--contact-mode",
+                "nominal",
+                "--out",
+                str(out),
+                "--no-progress",
+            ]
+        )
+        == 0
+    )
     assert (out / "report.md").stat().st_size > 0 and (out / "summary.csv").stat().st_size > 0
 
 

@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+
 from clearance.contact_calibration import laws
 from clearance.contact_calibration.laws import (
     ambrosio_friction,
@@ -26,7 +27,6 @@ from clearance.contact_calibration.laws import (
     lankarani_nikravesh,
     normal_force,
 )
-
 from clearance.model import STEEL, Clearance, ContactLaw, Material
 
 ULPS = 1e-12  # rel. tolerance: rounding of a few floating-point operations
@@ -131,9 +131,7 @@ def test_impact_law_by_hand() -> None:
     assert impact_law(1.6e-5, -1e-3, **kw) == pytest.approx(540.0, rel=ULPS)
     assert impact_law(1.6e-5, -1.0, **kw) == 0.0  # 640 - 1e5 < 0: clipped (exact)
     assert impact_law(-D, 5.0, **kw) == 0.0  # outside contact (exact)
-    assert normal_force(ContactLaw.IMPACT, D, 0.5, None, restitution=0.9, **kw) == impact_law(
-        D, 0.5, **kw
-    )
+    assert normal_force(ContactLaw.IMPACT, D, 0.5, None, restitution=0.9, **kw) == impact_law(D, 0.5, **kw)
 
 
 def test_ambrosio_friction_by_hand() -> None:

@@ -11,7 +11,6 @@ from clearance.analysis.sweeps.sweep import (
     evaluate_point,
 )
 from clearance.builders import rpm, slider_crank
-
 from clearance.options import ModelOptions
 from clearance.run.simulation import default_duration
 

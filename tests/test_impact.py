@@ -6,6 +6,7 @@ import math
 
 import numpy as np
 import pytest
+
 from clearance.contact_calibration.impact import (
     ImpactResult,
     clearance_impact,
@@ -15,7 +16,6 @@ from clearance.contact_calibration.impact import (
     simulate_oblique_impact,
 )
 from clearance.contact_calibration.laws import impact_law, lankarani_nikravesh
-
 from clearance.model import Clearance, ContactLaw
 
 LN = ContactLaw.LANKARANI_NIKRAVESH
@@ -61,8 +61,7 @@ def test_hertz_impact_matches_closed_form(stiffness: float, mass: float, speed: 
 
 
 def test_linear_spring_impact_is_half_a_period() -> None:
-    r = law_impact(ContactLaw.HERTZ, mass=0.5, speed=2.0, stiffness=1e8, restitution=1.0,
-                   exponent=1.0)
+    r = law_impact(ContactLaw.HERTZ, mass=0.5, speed=2.0, stiffness=1e8, restitution=1.0, exponent=1.0)
     assert r.duration == pytest.approx(math.pi * math.sqrt(0.5 / 1e8), rel=CLOSED_FORM_RTOL)
     assert r.max_penetration == pytest.approx(2.0 * math.sqrt(0.5 / 1e8), rel=CLOSED_FORM_RTOL)
 
@@ -70,8 +69,7 @@ def test_linear_spring_impact_is_half_a_period() -> None:
 def test_result_record_is_consistent() -> None:
     r = law_impact(LN, mass=0.21, speed=1.0, stiffness=K_SC, restitution=0.9, n_samples=500)
     assert isinstance(r, ImpactResult)
-    for a in (r.times, r.penetration, r.penetration_rate, r.force, r.tangential_velocity,
-              r.tangential_force):
+    for a in (r.times, r.penetration, r.penetration_rate, r.force, r.tangential_velocity, r.tangential_force):
         assert a.shape == (500,)
     assert r.times[0] == 0.0 and r.times[-1] == pytest.approx(r.duration, rel=1e-14)  # linspace
     assert r.penetration[0] == 0.0 and r.penetration_rate[0] == 1.0  # initial state, exact
@@ -115,7 +113,9 @@ def test_ln_restitution_independent_of_speed_mass_stiffness() -> None:
     # 1e-8 is a hundred times that.
     values = [
         law_impact(LN, mass=m, speed=v, stiffness=k, restitution=0.9, n_samples=2).restitution
-        for k in (1e9, 1e12) for m in (0.01, 1.0, 10.0) for v in (0.001, 1.0, 20.0)
+        for k in (1e9, 1e12)
+        for m in (0.01, 1.0, 10.0)
+        for v in (0.001, 1.0, 20.0)
     ]
     assert max(values) - min(values) < 1e-8
 
@@ -149,8 +149,7 @@ def test_free_flight_inside_penetration_zone() -> None:
     assert r.penetration[-1] == pytest.approx(0.0, abs=1e-12 * r.max_penetration)  # event
     # Converged: a tighter run agrees to 1e-7 (measured 1e-9 between rtol 1e-10 and 1e-12;
     # a coasting step straddling the re-push region used to lose 1.5e-4 here).
-    tight = law_impact(ContactLaw.IMPACT, mass=0.21, speed=1.0, restitution=0.9, rtol=1e-12,
-                       n_samples=2, **kw)
+    tight = law_impact(ContactLaw.IMPACT, mass=0.21, speed=1.0, restitution=0.9, rtol=1e-12, n_samples=2, **kw)
     assert r.restitution == pytest.approx(tight.restitution, rel=1e-7)
     assert r.force.max() == pytest.approx(
         float(impact_law(r.penetration, r.penetration_rate, **kw).max()), rel=1e-14
@@ -183,8 +182,7 @@ def test_thin_push_during_free_flight_is_not_stepped_over() -> None:
 
 
 def test_oblique_impact_without_friction_keeps_tangential_speed() -> None:
-    r = simulate_oblique_impact(_ln(0.9), mass=0.21, normal_speed=1.0, tangential_speed=0.5,
-                                friction=0.0)
+    r = simulate_oblique_impact(_ln(0.9), mass=0.21, normal_speed=1.0, tangential_speed=0.5, friction=0.0)
     # The tangential equation is identically zero: only interpolation rounding.
     np.testing.assert_allclose(r.tangential_velocity, 0.5, rtol=1e-14)
     assert not r.tangential_force.any()  # exact zero
@@ -193,8 +191,7 @@ def test_oblique_impact_without_friction_keeps_tangential_speed() -> None:
 @pytest.mark.parametrize("vt", [0.5, -0.5])
 def test_oblique_impact_full_slip_loses_mu_times_normal_impulse(vt: float) -> None:
     mu = 0.1
-    r = simulate_oblique_impact(_ln(0.9), mass=0.21, normal_speed=1.0, tangential_speed=vt,
-                                friction=mu)
+    r = simulate_oblique_impact(_ln(0.9), mass=0.21, normal_speed=1.0, tangential_speed=vt, friction=mu)
     speed = np.abs(r.tangential_velocity)
     assert np.all(np.diff(speed) <= 1e-15)  # non-increasing (1e-15: rounding)
     assert np.all(np.sign(r.tangential_velocity) == np.sign(vt))
@@ -207,8 +204,7 @@ def test_oblique_impact_full_slip_loses_mu_times_normal_impulse(vt: float) -> No
 def test_oblique_impact_slows_to_v0_without_reversing() -> None:
     # μ (1 + e) v ≈ 0.96 m/s of possible loss against 0.05 m/s of sliding: Ambrósio's law
     # cannot stick, so v_T decays towards v0 = 1e-4 m/s and never reverses.
-    r = simulate_oblique_impact(_ln(0.9), mass=0.21, normal_speed=1.0, tangential_speed=0.05,
-                                friction=0.5)
+    r = simulate_oblique_impact(_ln(0.9), mass=0.21, normal_speed=1.0, tangential_speed=0.05, friction=0.5)
     v = r.tangential_velocity
     # Non-increasing up to the absolute tolerance on the scaled tangential state (1e-10 of
     # the normal speed): near v0 the ramp's kink makes the interpolant wiggle by ~1e-11 m/s.
@@ -238,11 +234,9 @@ def test_bad_input_elsewhere() -> None:
     with pytest.raises(ValueError, match="force"):
         simulate_impact(None, mass=1.0, speed=1.0)  # type: ignore[arg-type]
     with pytest.raises(ValueError, match="tangential_speed"):
-        simulate_oblique_impact(_ln(0.9), mass=1.0, normal_speed=1.0,
-                                tangential_speed=float("nan"), friction=0.1)
+        simulate_oblique_impact(_ln(0.9), mass=1.0, normal_speed=1.0, tangential_speed=float("nan"), friction=0.1)
     with pytest.raises(ValueError, match="friction"):
-        simulate_oblique_impact(_ln(0.9), mass=1.0, normal_speed=1.0, tangential_speed=1.0,
-                                friction=-0.1)
+        simulate_oblique_impact(_ln(0.9), mass=1.0, normal_speed=1.0, tangential_speed=1.0, friction=-0.1)
     with pytest.raises(ValueError, match="c_max"):
         law_impact(ContactLaw.IMPACT, mass=1.0, speed=1.0, stiffness=K_SC, restitution=0.9)
     with pytest.raises(ValueError, match="restitution"):

@@ -6,8 +6,8 @@ import math
 
 import numpy as np
 import pytest
-from clearance.builders import CATALOGUE, four_bar, rpm, seven_bar_press, slider_crank
 
+from clearance.builders import CATALOGUE, four_bar, rpm, seven_bar_press, slider_crank
 from clearance.kinematics import (
     AssemblyError,
     ConstraintSystem,

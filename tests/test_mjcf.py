@@ -8,6 +8,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+
 from clearance.builders import slider_crank
 from clearance.mjcf import (
     RingGeometry,
@@ -16,7 +17,6 @@ from clearance.mjcf import (
     force_ripple,
     ring_force,
 )
-
 from clearance.options import ContactParameters, GeomType, ModelOptions
 from clearance.run.preparation import prepare
 
@@ -38,8 +38,11 @@ def _step_without_warnings(xml: str, steps: int = 2000) -> mujoco.MjData:
     mujoco.mj_resetDataKeyframe(model, data, 0)
     for _ in range(steps):
         mujoco.mj_step(model, data)
-    fired = {mujoco.mjtWarning(i).name: data.warning[i].number for i in range(mujoco.mjtWarning.mjNWARNING.value)
-             if data.warning[i].number}
+    fired = {
+        mujoco.mjtWarning(i).name: data.warning[i].number
+        for i in range(mujoco.mjtWarning.mjNWARNING.value)
+        if data.warning[i].number
+    }
     assert not fired, f"MuJoCo warnings: {fired}"
     return data
 
@@ -72,16 +75,23 @@ def test_every_cli_geom_pair_touches_and_steps_without_warnings(pair):
     c = 0.5e-3  # the builder's radial clearance
     # 2 um into each ring, so both are in contact from the first step: one journal towards a
     # segment centre, the other between two segments (36 segments: pitch 10 deg)
-    targets = {"rod_slider": (c + 2e-6, 0.0), "crank_rod": ((c + 2e-6) * np.cos(np.pi / 36), (c + 2e-6) * np.sin(np.pi / 36))}
-    data.qpos[:] = offset_journals(model, model.key_qpos[0], targets, bearings={k: c for k in targets},
-                                   fixed_joints=["crank_pivot"])
+    targets = {
+        "rod_slider": (c + 2e-6, 0.0),
+        "crank_rod": ((c + 2e-6) * np.cos(np.pi / 36), (c + 2e-6) * np.sin(np.pi / 36)),
+    }
+    data.qpos[:] = offset_journals(
+        model, model.key_qpos[0], targets, bearings={k: c for k in targets}, fixed_joints=["crank_pivot"]
+    )
     touched = set()
     for _ in range(2000):
         mujoco.mj_step(model, data)
         touched |= {model.geom(data.contact.geom1[k]).name.split("__")[0] for k in range(data.ncon)}
         touched |= {model.geom(data.contact.geom2[k]).name.split("__")[0] for k in range(data.ncon)}
-    fired = {mujoco.mjtWarning(i).name: data.warning[i].number for i in range(mujoco.mjtWarning.mjNWARNING.value)
-             if data.warning[i].number}
+    fired = {
+        mujoco.mjtWarning(i).name: data.warning[i].number
+        for i in range(mujoco.mjtWarning.mjNWARNING.value)
+        if data.warning[i].number
+    }
     assert not fired, f"MuJoCo warnings: {fired}"
     assert {"crank_rod", "rod_slider"} <= touched  # both journals met their rings
     assert np.all(np.isfinite(data.qpos))
@@ -113,7 +123,11 @@ def test_physical_row_stiffness_mapping():
     data.qvel[:] = 0
     mujoco.mj_forward(model, data)
     f = ring_force(RingGeometry.make(0.01, 0.5e-3, 72), np.array([0.5e-3 + 5e-6, 0.0]), stiffness=k)
-    total = sum(data.efc_force[i] for i in range(data.nefc) if data.efc_type[i] == mujoco.mjtConstraint.mjCNSTR_CONTACT_FRICTIONLESS)
+    total = sum(
+        data.efc_force[i]
+        for i in range(data.nefc)
+        if data.efc_type[i] == mujoco.mjtConstraint.mjCNSTR_CONTACT_FRICTIONLESS
+    )
     assert model.pair_solref[pid][0] < 0  # direct mode
     # rows act almost independently at impedance 1e-3 (coupling of order d = 0.1 %), the
     # approximate inverse weight is exact for this pair's bodies: 2 % covers both

@@ -5,8 +5,8 @@ from __future__ import annotations
 import dataclasses
 
 import pytest
-from clearance.builders import slider_crank
 
+from clearance.builders import slider_crank
 from clearance.kinematics import AssemblyError, assemble
 from clearance.model import Clearance, Drive, Link, Mechanism
 from clearance.options import ModelOptions

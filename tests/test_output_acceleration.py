@@ -5,9 +5,9 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from clearance.builders import seven_bar_press
 
 from clearance import ModelOptions, simulate
+from clearance.builders import seven_bar_press
 from clearance.kinematics import solve_kinematics
 
 

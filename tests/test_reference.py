@@ -11,12 +11,12 @@ import math
 
 import numpy as np
 import pytest
+
 from clearance.builders import rpm, slider_crank
 from clearance.contact_calibration.impact import clearance_impact
+from clearance.model import Clearance, ContactLaw
 from clearance.reference import run_reference, simulate_system
 from clearance.reference.examples import journal_in_bearing
-
-from clearance.model import Clearance, ContactLaw
 
 R, L = 0.05, 0.12  # crank and rod length of the classic slider-crank [m]
 
@@ -62,8 +62,7 @@ def test_ideal_extremes_match_reference_table(
 ) -> None:
     omega = rpm(speed_rpm)
     period = 2 * math.pi / omega
-    res = run_reference(slider_crank(clearance_at=(), crank_speed=omega), period,
-                        output_interval=period / 20000)
+    res = run_reference(slider_crank(clearance_at=(), crank_speed=omega), period, output_interval=period / 20000)
     acc = res.outputs["slider_x_acc"]
     assert abs(acc.min() - acc_min) < acc_tol
     assert abs(acc.max() - acc_max) < acc_tol
@@ -145,8 +144,9 @@ def test_no_impact_is_stepped_over_in_long_free_flights() -> None:
     system = ReferenceSystem(mech, baumgarte=(0.0, 0.0))
     z0, zd0 = system.to_com(*system.initial_state())
     atol = 1e-9 * np.array([5e-4, 5e-4, 4e-3] * 3 + [5e-2, 5e-2, 0.4] * 3)
-    traj = integrate_system(system, z0, zd0, 2 * math.pi / omega, output_interval=1e-5,
-                            rtol=1e-9, atol=atol, method="DOP853")
+    traj = integrate_system(
+        system, z0, zd0, 2 * math.pi / omega, output_interval=1e-5, rtol=1e-9, atol=atol, method="DOP853"
+    )
     delta, _ = gap_many(system, 0, np.concatenate([traj.z, traj.zd], axis=1).T)
     free = traj.vin[:, 0] == 0.0
     assert len(traj.onsets) > 10

@@ -9,8 +9,10 @@ import math
 
 import numpy as np
 import pytest
+
 from clearance.builders import slider_crank
 from clearance.contact_calibration import laws
+from clearance.model import Clearance, ContactLaw
 from clearance.reference import run_reference
 from clearance.reference.contact import (
     evaluate_contact,
@@ -19,16 +21,15 @@ from clearance.reference.contact import (
 )
 from clearance.reference.examples import journal_in_bearing
 
-from clearance.model import Clearance, ContactLaw
-
 ULPS = 1e-12  # rel. tolerance: the same formula evaluated in floats vs NumPy (rounding)
 IMPACT = dict(c_max=2e5, d_max=1e-5)
 
 
 def _joint(law: ContactLaw, restitution: float = 0.8, friction: float = 0.0):
     cl = Clearance(radial_clearance=0.5e-3, restitution=restitution, friction=friction, law=law)
-    system, _, _ = journal_in_bearing(cl, mass=0.2, speed=1.0, impact_c_max=IMPACT["c_max"],
-                                      impact_d_max=IMPACT["d_max"])
+    system, _, _ = journal_in_bearing(
+        cl, mass=0.2, speed=1.0, impact_c_max=IMPACT["c_max"], impact_d_max=IMPACT["d_max"]
+    )
     return cl, system.contacts[0]
 
 
@@ -36,10 +37,10 @@ def _joint(law: ContactLaw, restitution: float = 0.8, friction: float = 0.0):
 def test_scalar_normal_force_equals_contact_laws(law: ContactLaw) -> None:
     cl, cj = _joint(law)
     assert cj.stiffness == laws.bearing_stiffness(cl)
-    for d, dd, v in itertools.product((-1e-6, 0.0, 1e-7, 5e-6, 3e-5, 2e-5 + 1e-9),
-                                      (-3.0, -0.5, 0.0, 0.7, 2.0), (0.5, 2.0)):
-        ref = laws.normal_force(law, d, dd, v, stiffness=cj.stiffness, restitution=cl.restitution,
-                                **IMPACT)
+    for d, dd, v in itertools.product(
+        (-1e-6, 0.0, 1e-7, 5e-6, 3e-5, 2e-5 + 1e-9), (-3.0, -0.5, 0.0, 0.7, 2.0), (0.5, 2.0)
+    ):
+        ref = laws.normal_force(law, d, dd, v, stiffness=cj.stiffness, restitution=cl.restitution, **IMPACT)
         assert normal_force_scalar(cj, d, dd, v) == pytest.approx(ref, rel=ULPS, abs=0.0)
 
 
@@ -63,8 +64,7 @@ def test_circle_in_circle_geometry_by_hand() -> None:
     ft = laws.ambrosio_friction(fn, vt, friction=0.1)
     fx, fy = -fn * nx - ft * ny, -fn * ny + ft * nx
     # moments about the centres of mass: journal R_J F_T; bearing (ground here) -R_B F_T
-    expected = (ex, ey, vx, vy, delta, ddot, vt, fx, fy, cl.journal_radius * ft,
-                -cl.bearing_radius * ft, fn, ft)
+    expected = (ex, ey, vx, vy, delta, ddot, vt, fx, fy, cl.journal_radius * ft, -cl.bearing_radius * ft, fn, ft)
     # abs 1e-18: lets exact zeros compare with rounding-level values (quantities >= 1e-6)
     assert r == pytest.approx(expected, rel=ULPS, abs=1e-18)
     # free mode (approach speed 0): geometry but no force

@@ -13,9 +13,8 @@ import math
 
 import numpy as np
 import pytest
-from clearance.builders import rpm, slider_crank
-from clearance.reference import ReferenceSystem, run_reference
 
+from clearance.builders import rpm, slider_crank
 from clearance.kinematics import ConstraintSystem, solve_kinematics
 from clearance.model import (
     Clearance,
@@ -29,13 +28,20 @@ from clearance.model import (
     Output,
     OutputKind,
 )
+from clearance.reference import ReferenceSystem, run_reference
 
 
 def _bar(name: str, p: tuple[float, float], q: tuple[float, float], pa: str, pb: str, mass: float) -> Link:
     length = math.dist(p, q)
     th = math.atan2(q[1] - p[1], q[0] - p[0])
-    return Link(name, mass, mass * length**2 / 12, com=(length / 2, 0.0),
-                points={pa: (0.0, 0.0), pb: (length, 0.0)}, pose_guess=(p[0], p[1], th))
+    return Link(
+        name,
+        mass,
+        mass * length**2 / 12,
+        com=(length / 2, 0.0),
+        points={pa: (0.0, 0.0), pb: (length, 0.0)},
+        pose_guess=(p[0], p[1], th),
+    )
 
 
 def _meet(p: tuple[float, float], r1: float, q: tuple[float, float], r2: float) -> tuple[float, float]:
@@ -65,8 +71,7 @@ def four_bar(clearance: bool = False, *, speed: float = rpm(1500), restitution: 
     joints = (
         Joint("O2", JointType.REVOLUTE, "ground", "o2", "crank", "o"),
         Joint("A", JointType.REVOLUTE, "crank", "a", "coupler", "a"),
-        Joint("B", JointType.REVOLUTE, "coupler", "b", "rocker", "b",
-              clearance=_clearance(clearance, restitution)),
+        Joint("B", JointType.REVOLUTE, "coupler", "b", "rocker", "b", clearance=_clearance(clearance, restitution)),
         Joint("O4", JointType.REVOLUTE, "ground", "o4", "rocker", "o"),
     )
     drives = (Drive("crank", "O2", DriveKind.CONSTANT_SPEED, speed=speed),)
@@ -94,17 +99,19 @@ def five_bar(clearance: bool = False, *, restitution: float = 0.9) -> Mechanism:
         Joint("O2", JointType.REVOLUTE, "ground", "o2", "crank2", "o"),
         Joint("A1", JointType.REVOLUTE, "crank1", "a", "coupler1", "a"),
         Joint("A2", JointType.REVOLUTE, "crank2", "a", "coupler2", "a"),
-        Joint("P", JointType.REVOLUTE, "coupler1", "p", "coupler2", "p",
-              clearance=_clearance(clearance, restitution)),
+        Joint("P", JointType.REVOLUTE, "coupler1", "p", "coupler2", "p", clearance=_clearance(clearance, restitution)),
     )
     w = rpm(1000)
     drives = (
         Drive("d1", "O1", DriveKind.CONSTANT_SPEED, speed=w),
-        Drive("d2", "O2", DriveKind.MOTION_LAW, start_angle=math.pi,
-              motion=MotionLaw(speed=w, harmonics=((0.2, 0.3),))),
+        Drive(
+            "d2", "O2", DriveKind.MOTION_LAW, start_angle=math.pi, motion=MotionLaw(speed=w, harmonics=((0.2, 0.3),))
+        ),
     )
-    outputs = (Output("p_x", "coupler1", OutputKind.POSITION_X, point="p"),
-               Output("p_y", "coupler1", OutputKind.POSITION_Y, point="p"))
+    outputs = (
+        Output("p_x", "coupler1", OutputKind.POSITION_X, point="p"),
+        Output("p_y", "coupler1", OutputKind.POSITION_Y, point="p"),
+    )
     return Mechanism("five_bar_test", links, joints, drives, outputs)
 
 
@@ -138,8 +145,9 @@ def _energy_residual(res) -> float:
     return float(np.max(np.abs(kin + pot - kin[0] - pot[0] - work + grav - grav[0])) / kin.max())
 
 
-@pytest.mark.parametrize("mech", [four_bar(True, restitution=1.0), five_bar(True, restitution=1.0)],
-                         ids=["four_bar", "five_bar"])
+@pytest.mark.parametrize(
+    "mech", [four_bar(True, restitution=1.0), five_bar(True, restitution=1.0)], ids=["four_bar", "five_bar"]
+)
 def test_closed_loops_with_elastic_clearance_conserve_energy(mech: Mechanism) -> None:
     res = run_reference(mech, 8e-3, track_work=True)
     assert sum(res.metadata["impacts"].values()) >= 1  # the journal did hit its bearing
@@ -163,8 +171,9 @@ def test_torque_drive_applies_its_torque() -> None:
     assert _energy_residual(res) < 1e-5  # issue goal (energy conservation)
 
 
-@pytest.mark.parametrize("mech", [slider_crank(), four_bar(True), five_bar(True)],
-                         ids=["slider_crank", "four_bar", "five_bar"])
+@pytest.mark.parametrize(
+    "mech", [slider_crank(), four_bar(True), five_bar(True)], ids=["slider_crank", "four_bar", "five_bar"]
+)
 def test_constraint_rows_match_kinematics_constraint_system(mech: Mechanism) -> None:
     system = ReferenceSystem(mech, baumgarte=(0.0, 0.0))
     cs = ConstraintSystem(mech, include_clearance=False)
@@ -186,14 +195,19 @@ def test_constraint_rows_match_kinematics_constraint_system(mech: Mechanism) -> 
         for j in range(len(z)):
             dz = np.zeros_like(z)
             dz[j] = h
-            fd[:, j] = (np.array(system.rows.evaluate(t, (z + dz).tolist())[0])
-                        - np.array(system.rows.evaluate(t, (z - dz).tolist())[0])) / (2 * h)
+            fd[:, j] = (
+                np.array(system.rows.evaluate(t, (z + dz).tolist())[0])
+                - np.array(system.rows.evaluate(t, (z - dz).tolist())[0])
+            ) / (2 * h)
         assert np.allclose(g, fd, rtol=0, atol=1e-8)
         # gamma = -(d^2/ds^2) phi(z + s zd) at fixed t for the joint rows (second differences,
         # step 1e-4: truncation ~1e-8 relative to |zd|^2 = O(10))
         s = 1e-4
-        second = (np.array(system.rows.evaluate(t, (z + s * zd).tolist())[0]) - 2 * np.array(phi)
-                  + np.array(system.rows.evaluate(t, (z - s * zd).tolist())[0])) / s**2
+        second = (
+            np.array(system.rows.evaluate(t, (z + s * zd).tolist())[0])
+            - 2 * np.array(phi)
+            + np.array(system.rows.evaluate(t, (z - s * zd).tolist())[0])
+        ) / s**2
         npairs = 2 * len(system.rows.pairs)
         assert np.allclose(np.array(gam)[:npairs], -second[:npairs], rtol=0, atol=1e-5)
 
@@ -204,8 +218,11 @@ def _catalogue():
 
     if hasattr(builders, "names") and hasattr(builders, "build"):
         return [pytest.param(lambda n=name: builders.build(n), id=name) for name in builders.names()]
-    return [pytest.param(getattr(builders, name), id=name) for name in getattr(builders, "__all__", [])
-            if inspect.isfunction(getattr(builders, name)) and name != "rpm"]
+    return [
+        pytest.param(getattr(builders, name), id=name)
+        for name in getattr(builders, "__all__", [])
+        if inspect.isfunction(getattr(builders, name)) and name != "rpm"
+    ]
 
 
 @pytest.mark.parametrize("builder", _catalogue())

@@ -5,13 +5,13 @@ from __future__ import annotations
 import math
 from pathlib import Path
 
-import clearance.builders
 import numpy as np
 import pytest
 import rerun as rr
-from clearance.analysis.recording import rerun_log
 
 import clearance
+import clearance.builders
+from clearance.analysis.recording import rerun_log
 from clearance.results import JointResult, SimulationResult
 
 # Points2D / LineStrips2D store float32: a float64 value x comes back as float32(x), whose
@@ -53,7 +53,9 @@ def _read(path: Path) -> tuple[dict[tuple[str, bool], dict[str, np.ndarray]], li
         if rerun_log.TIME_TIMELINE in d:
             order = np.argsort(np.asarray(d[rerun_log.TIME_TIMELINE]), kind="stable")
             d = {k: [v[i] for i in order] for k, v in d.items()}
-        out[key] = {k: np.asarray(v, dtype=object) if k.endswith(("labels", "strips")) else np.asarray(v) for k, v in d.items()}
+        out[key] = {
+            k: np.asarray(v, dtype=object) if k.endswith(("labels", "strips")) else np.asarray(v) for k, v in d.items()
+        }
     blueprints = [c for b in reader.blueprints() for c in reader.stream(store=b)]
     return out, blueprints
 
@@ -94,9 +96,15 @@ def test_single_joint_recording_matches_the_run(runs, tmp_path):
     force = data[("/joints/rod_slider/force/magnitude", False)]
     assert np.array_equal(force[rerun_log.TIME_TIMELINE], ns)
     assert np.array_equal(_squeeze(force["Scalars:scalars"]), jr.force_magnitude)
-    assert np.array_equal(_squeeze(data[("/joints/rod_slider/force/x", False)]["Scalars:scalars"]), jr.contact_force[:, 0])
-    assert np.array_equal(_squeeze(data[("/joints/rod_slider/force/y", False)]["Scalars:scalars"]), jr.contact_force[:, 1])
-    assert np.array_equal(_squeeze(data[("/joints/rod_slider/penetration", False)]["Scalars:scalars"]), jr.penetration * 1e6)
+    assert np.array_equal(
+        _squeeze(data[("/joints/rod_slider/force/x", False)]["Scalars:scalars"]), jr.contact_force[:, 0]
+    )
+    assert np.array_equal(
+        _squeeze(data[("/joints/rod_slider/force/y", False)]["Scalars:scalars"]), jr.contact_force[:, 1]
+    )
+    assert np.array_equal(
+        _squeeze(data[("/joints/rod_slider/penetration", False)]["Scalars:scalars"]), jr.penetration * 1e6
+    )
 
     contact = data[("/joints/rod_slider/contact", False)]
     on = jr.penetration > 0
@@ -129,14 +137,28 @@ def test_single_joint_recording_matches_the_run(runs, tmp_path):
     assert len(data[("/mechanism/links", True)]["LineStrips2D:labels"][0]) == 3
 
     expected = {
-        "/joints/rod_slider/orbit", "/joints/rod_slider/contact", "/joints/rod_slider/clearance_circle",
-        "/joints/rod_slider/poincare", "/joints/rod_slider/force/magnitude", "/mechanism/links",
-        "/mechanism/joints", "/mechanism/ground", "/drives/crank/speed", "/drives/crank/torque",
+        "/joints/rod_slider/orbit",
+        "/joints/rod_slider/contact",
+        "/joints/rod_slider/clearance_circle",
+        "/joints/rod_slider/poincare",
+        "/joints/rod_slider/force/magnitude",
+        "/mechanism/links",
+        "/mechanism/joints",
+        "/mechanism/ground",
+        "/drives/crank/speed",
+        "/drives/crank/torque",
     }
     assert expected <= {e for e, _ in data}
     assert blueprints, "the file carries a default blueprint"
-    assert {"mechanism [mm]", "orbit rod_slider [µm, bearing frame]", "contact force [N]", "slider_x displacement",
-            "slider_x velocity", "slider_x acceleration", "drive speed [rad/s]"} <= _view_names(blueprints)
+    assert {
+        "mechanism [mm]",
+        "orbit rod_slider [µm, bearing frame]",
+        "contact force [N]",
+        "slider_x displacement",
+        "slider_x velocity",
+        "slider_x acceleration",
+        "drive speed [rad/s]",
+    } <= _view_names(blueprints)
 
 
 def test_two_clearance_joints(runs, tmp_path):
@@ -156,11 +178,18 @@ def _reference_like(res: SimulationResult, mech) -> SimulationResult:
     """A reference-solver-shaped result: every 10th row, link-frame poses, solver "reference"."""
     r = res.decimated(10)
     poses = r.link_poses.copy()  # link-frame poses, as both solvers store them
-    joints = {k: JointResult(v.eccentricity, v.eccentricity_rate, v.penetration, v.contact_force) for k, v in r.joints.items()}
-    meta = {"solver": "reference", "mechanism": mech.name, "clearance_joints": list(joints),
-            "links": [lk.name for lk in mech.moving_links]}
-    return SimulationResult(r.times, dict(r.outputs), joints, r.drive_angle, r.drive_speed, r.drive_torque,
-                            poses, r.closure_violation, meta)
+    joints = {
+        k: JointResult(v.eccentricity, v.eccentricity_rate, v.penetration, v.contact_force) for k, v in r.joints.items()
+    }
+    meta = {
+        "solver": "reference",
+        "mechanism": mech.name,
+        "clearance_joints": list(joints),
+        "links": [lk.name for lk in mech.moving_links],
+    }
+    return SimulationResult(
+        r.times, dict(r.outputs), joints, r.drive_angle, r.drive_speed, r.drive_torque, poses, r.closure_violation, meta
+    )
 
 
 def test_mujoco_and_reference_in_one_recording(runs, tmp_path):
@@ -168,11 +197,14 @@ def test_mujoco_and_reference_in_one_recording(runs, tmp_path):
     ref = _reference_like(res, mech)
     path = rerun_log.record_runs(
         [rerun_log.LoggedRun(res, mech, prefix="mujoco/"), rerun_log.LoggedRun(ref, mech, prefix="reference")],
-        tmp_path / "both.rrd", max_rate_hz=None,
+        tmp_path / "both.rrd",
+        max_rate_hz=None,
     )
     data, blueprints = _read(path)
     for prefix, r in (("mujoco", res), ("reference", ref)):
-        pos = np.asarray([row[0] for row in data[(f"/{prefix}/joints/rod_slider/orbit", False)]["Points2D:positions"]], float)
+        pos = np.asarray(
+            [row[0] for row in data[(f"/{prefix}/joints/rod_slider/orbit", False)]["Points2D:positions"]], float
+        )
         np.testing.assert_allclose(pos, r.joints["rod_slider"].eccentricity * 1e6, rtol=F32_RTOL, atol=0)
         force = _squeeze(data[(f"/{prefix}/joints/rod_slider/force/magnitude", False)]["Scalars:scalars"])
         assert np.array_equal(force, r.joints["rod_slider"].force_magnitude)
@@ -182,8 +214,13 @@ def test_mujoco_and_reference_in_one_recording(runs, tmp_path):
     np.testing.assert_allclose(jf, jm[::10], atol=1e-4)
     names = _view_names(blueprints)
     assert "orbit rod_slider [µm, bearing frame]" in names
-    queries = [q for c in blueprints for rb in [c.to_record_batch()] if "ViewContents:query" in rb.schema.names
-               for q in rb.column("ViewContents:query").to_pylist()[0]]
+    queries = [
+        q
+        for c in blueprints
+        for rb in [c.to_record_batch()]
+        if "ViewContents:query" in rb.schema.names
+        for q in rb.column("ViewContents:query").to_pylist()[0]
+    ]
     assert "+ /mujoco/joints/rod_slider/force/magnitude" in queries
     assert "+ /reference/joints/rod_slider/force/magnitude" in queries
 
@@ -226,11 +263,12 @@ def test_cli_run_writes_a_recording(tmp_path):
     import stat
 
     from clearance.analysis.chaos.poincare import poincare_from_result
-
     from clearance.cli import main
 
     rrd = tmp_path / "run.rrd"
-    assert main(["run", "--duration-ms", "0.3", "--out", str(tmp_path / "out"), "--no-progress", "--rerun", str(rrd)]) == 0
+    assert (
+        main(["run", "--duration-ms", "0.3", "--out", str(tmp_path / "out"), "--no-progress", "--rerun", str(rrd)]) == 0
+    )
     data, blueprints = _read(rrd)
     assert ("/joints/rod_slider/orbit", False) in data and ("/outputs/slider_x/displacement/ideal", False) in data
     assert blueprints
@@ -263,8 +301,10 @@ def test_importing_the_simulation_does_not_load_rerun():
     import subprocess
     import sys
 
-    code = ("import sys; import clearance; from clearance import simulate; import clearance.reference; "
-            "sys.exit('rerun' in sys.modules)")
+    code = (
+        "import sys; import clearance; from clearance import simulate; import clearance.reference; "
+        "sys.exit('rerun' in sys.modules)"
+    )
     assert subprocess.run([sys.executable, "-c", code]).returncode == 0
 
 
@@ -280,7 +320,9 @@ def test_reference_solver_run_records_like_a_mujoco_run(runs, tmp_path):
         tmp_path / "cmp.rrd",
     )
     data, _ = _read(path)
-    pos = np.asarray([row[0] for row in data[("/reference/joints/rod_slider/orbit", False)]["Points2D:positions"]], float)
+    pos = np.asarray(
+        [row[0] for row in data[("/reference/joints/rod_slider/orbit", False)]["Points2D:positions"]], float
+    )
     np.testing.assert_allclose(pos, ref.joints["rod_slider"].eccentricity * 1e6, rtol=F32_RTOL, atol=0)
     force = _squeeze(data[("/reference/joints/rod_slider/force/magnitude", False)]["Scalars:scalars"])
     assert np.array_equal(force, ref.joints["rod_slider"].force_magnitude)

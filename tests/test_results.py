@@ -11,8 +11,16 @@ def _result(n=50):
     rng = np.random.default_rng(0)
     return SimulationResult(
         times=np.arange(n) * 1e-6,
-        outputs={"slider_x": rng.normal(size=n), "slider_x_vel": rng.normal(size=n), "slider_x_acc": rng.normal(size=n)},
-        joints={"rod_slider": JointResult(rng.normal(size=(n, 2)), rng.normal(size=(n, 2)), rng.normal(size=n), rng.normal(size=(n, 2)))},
+        outputs={
+            "slider_x": rng.normal(size=n),
+            "slider_x_vel": rng.normal(size=n),
+            "slider_x_acc": rng.normal(size=n),
+        },
+        joints={
+            "rod_slider": JointResult(
+                rng.normal(size=(n, 2)), rng.normal(size=(n, 2)), rng.normal(size=n), rng.normal(size=(n, 2))
+            )
+        },
         drive_angle=rng.normal(size=(n, 1)),
         drive_speed=rng.normal(size=(n, 1)),
         drive_torque=rng.normal(size=(n, 1)),
@@ -50,7 +58,6 @@ def test_output_files_get_the_usual_mode_of_a_new_file(tmp_path):
     import stat
 
     from clearance.contact_calibration.store import save_calibration
-
     from clearance.results import atomic_write_text
 
     old = os.umask(0o022)

@@ -6,9 +6,9 @@ import math
 
 import numpy as np
 import pytest
-from clearance.builders import rpm, slider_crank
 
 from clearance import ModelOptions, simulate
+from clearance.builders import rpm, slider_crank
 from clearance.run.simulation import SimulationError
 
 
@@ -70,6 +70,7 @@ def test_deepest_penetration_is_the_ln_impact_of_the_fastest_approach(clearance_
     The bound above is loose by design (4x, to catch divergence); this is the physical check.
     """
     import mujoco
+
     from clearance.contact_calibration import clearance_impact
     from clearance.contact_calibration.effective_mass import normal_effective_mass
     from clearance.mjcf import ring_force
@@ -83,7 +84,7 @@ def test_deepest_penetration_is_the_ln_impact_of_the_fastest_approach(clearance_
     approach = np.sum(eo * jr.eccentricity_rate[onsets], axis=1) / np.hypot(*eo.T)  # d|e|/dt [m/s]
     i = int(onsets[np.argmax(approach)])  # the fastest approach of the run (the first impact)
     v = float(approach.max())
-    depth = float(jr.penetration[i:i + int(np.argmax(~on[i:]))].max())
+    depth = float(jr.penetration[i : i + int(np.argmax(~on[i:]))].max())
     assert depth == jr.penetration.max()  # that impact is also the deepest
     # the mass it meets along its normal: replay the run to row i (sensor row i is at i h)
     data = mujoco.MjData(p.model)
@@ -183,11 +184,14 @@ def test_divergence_names_time_joint_and_keeps_partial():
     assert err.partial.times[-1] < err.time + 1e-12
 
 
-@pytest.mark.parametrize("stiffness, reason", [
-    # per-row stiffness far beyond any bearing's (it passes validation: finite and > 0)
-    (1e300, "the state became non-finite"),  # the first contact step overflows to Inf/NaN
-    (1e100, "MuJoCo raised warnings ['mjWARN_BADQACC']"),  # a huge but finite acceleration
-])
+@pytest.mark.parametrize(
+    "stiffness, reason",
+    [
+        # per-row stiffness far beyond any bearing's (it passes validation: finite and > 0)
+        (1e300, "the state became non-finite"),  # the first contact step overflows to Inf/NaN
+        (1e100, "MuJoCo raised warnings ['mjWARN_BADQACC']"),  # a huge but finite acceleration
+    ],
+)
 def test_non_finite_or_warning_stops_at_the_first_bad_step(stiffness, reason):
     from clearance.options import ContactParameters
 
@@ -215,19 +219,20 @@ def test_exact_ln_step_failure_carries_the_steps_before_it():
     import copy
 
     import mujoco
+
     from clearance.contact_calibration.exact_ln import (
         ExactLNContact,
         ExactLNStepError,
         step_exact_ln,
     )
-
     from clearance.run.preparation import prepare
 
     p = prepare(slider_crank(), ModelOptions(segments=36))
     model = copy.copy(p.model)
     j = p.mechanism.clearance_joints[0]
-    contact = ExactLNContact(model, j.clearance, p.built.rings[j.name], journal_geom=f"{j.name}__journal",
-                             bearing_site=f"{j.name}__bearing")
+    contact = ExactLNContact(
+        model, j.clearance, p.built.rings[j.name], journal_geom=f"{j.name}__journal", bearing_site=f"{j.name}__bearing"
+    )
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
     ctrl = np.tile(data.ctrl, (6, 1))
@@ -275,7 +280,9 @@ def test_torque_drive_starts_at_rest_in_its_start_pose():
     from clearance import Drive, DriveKind
 
     base = slider_crank(clearance_at=())
-    mech = dataclasses.replace(base, drives=(Drive("crank", "crank_pivot", DriveKind.TORQUE, torque=2.0, start_angle=0.5),))
+    mech = dataclasses.replace(
+        base, drives=(Drive("crank", "crank_pivot", DriveKind.TORQUE, torque=2.0, start_angle=0.5),)
+    )
     r = simulate(mech, duration=0.01, options=ModelOptions(timestep=1e-5))
     assert r.drive_angle[0, 0] == pytest.approx(0.5, abs=1e-12)  # assembled at the start angle
     assert r.drive_speed[0, 0] == 0.0

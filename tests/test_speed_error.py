@@ -8,6 +8,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
+
 from clearance.analysis.metrics.accuracy import (
     Statistic,
     first_impact,
@@ -16,7 +17,6 @@ from clearance.analysis.metrics.accuracy import (
     separation_time,
     statistic_errors,
 )
-
 from clearance.results import JointResult, SimulationResult
 
 
@@ -25,10 +25,19 @@ def _result(times, ecc, force, penetration, outputs=None) -> SimulationResult:
     return SimulationResult(
         times=np.asarray(times, float),
         outputs=outputs or {"y": np.zeros(n)},
-        joints={"J": JointResult(np.asarray(ecc, float), np.zeros((n, 2)), np.asarray(penetration, float),
-                                 np.column_stack([force, np.zeros(n)]))},
-        drive_angle=np.zeros((n, 1)), drive_speed=np.ones((n, 1)), drive_torque=np.zeros((n, 1)),
-        link_poses=np.zeros((n, 1, 3)), closure_violation=np.zeros(n),
+        joints={
+            "J": JointResult(
+                np.asarray(ecc, float),
+                np.zeros((n, 2)),
+                np.asarray(penetration, float),
+                np.column_stack([force, np.zeros(n)]),
+            )
+        },
+        drive_angle=np.zeros((n, 1)),
+        drive_speed=np.ones((n, 1)),
+        drive_torque=np.zeros((n, 1)),
+        link_poses=np.zeros((n, 1, 3)),
+        closure_violation=np.zeros(n),
     )
 
 
@@ -75,7 +84,9 @@ def test_run_statistics_values_and_batch_scatter() -> None:
     ecc = np.column_stack([np.where(contact, 1.0, 0.5), np.zeros(len(t))])
     y = 0.001 * np.sin(2 * np.pi * t / period)
     res = _result(t, ecc, force, pen, outputs={"y": y + 1e-4})
-    st = run_statistics(res, period=period, skip=period, blocks=4, ideal_output=lambda tt: 0.001 * np.sin(2 * np.pi * tt / period))
+    st = run_statistics(
+        res, period=period, skip=period, blocks=4, ideal_output=lambda tt: 0.001 * np.sin(2 * np.pi * tt / period)
+    )
     s = st["J"]
     assert s["contact_fraction"].value == pytest.approx(0.375, abs=1e-12)  # 6 revs at 0.5, 6 at 0.25
     assert s["impacts_per_rev"].value == pytest.approx(11 / 12, abs=1e-12)  # onsets at revs 2..12
@@ -94,10 +105,20 @@ def test_run_statistics_values_and_batch_scatter() -> None:
 
 
 def test_statistic_errors_scales() -> None:
-    ref = {"J": {"p95_force": Statistic(100.0, 2.0, 4), "ecc_std": Statistic(1e-8, 1e-9, 4),
-                 "impacts_per_rev": Statistic(0.0, 0.0, 4)}}
-    run = {"J": {"p95_force": Statistic(103.0, 1.5, 4), "ecc_std": Statistic(2e-8, 1e-9, 4),
-                 "impacts_per_rev": Statistic(0.5, 0.1, 4)}}
+    ref = {
+        "J": {
+            "p95_force": Statistic(100.0, 2.0, 4),
+            "ecc_std": Statistic(1e-8, 1e-9, 4),
+            "impacts_per_rev": Statistic(0.0, 0.0, 4),
+        }
+    }
+    run = {
+        "J": {
+            "p95_force": Statistic(103.0, 1.5, 4),
+            "ecc_std": Statistic(2e-8, 1e-9, 4),
+            "impacts_per_rev": Statistic(0.5, 0.1, 4),
+        }
+    }
     e = statistic_errors(run, ref, clearance={"J": 1e-4})["J"]
     assert e["p95_force"]["error"] == pytest.approx(0.03, rel=1e-12)
     assert e["p95_force"]["scatter"] == pytest.approx(np.hypot(2.0, 1.5) / 100, rel=1e-12)
@@ -128,11 +149,25 @@ def test_pareto_front_and_defaults() -> None:
     )
 
     def row(key, wall, stat, first):
-        return SettingRow("s", key, key, {}, "ok", wall_per_rev=wall, cpu_per_rev=wall, statistics_error=stat,
-                          first_impact_error=first)
+        return SettingRow(
+            "s",
+            key,
+            key,
+            {},
+            "ok",
+            wall_per_rev=wall,
+            cpu_per_rev=wall,
+            statistics_error=stat,
+            first_impact_error=first,
+        )
 
-    rows = [row("a", 1.0, 0.20, 0.05), row("b", 2.0, 0.04, 0.02), row("c", 3.0, 0.06, 0.004),
-            row("d", 4.0, 0.01, 0.008), SettingRow("s", "e", "e", {}, "error", "boom")]
+    rows = [
+        row("a", 1.0, 0.20, 0.05),
+        row("b", 2.0, 0.04, 0.02),
+        row("c", 3.0, 0.06, 0.004),
+        row("d", 4.0, 0.01, 0.008),
+        SettingRow("s", "e", "e", {}, "error", "boom"),
+    ]
     assert [r.key for r in pareto_front(rows, "statistics_error")] == ["a", "b", "d"]
     assert [r.key for r in pareto_front(rows, "first_impact_error")] == ["a", "b", "c"]
     d = choose_defaults(rows)
@@ -140,15 +175,21 @@ def test_pareto_front_and_defaults() -> None:
 
 
 def test_bench_pipeline_end_to_end_and_resume(tmp_path, monkeypatch) -> None:
-    from clearance.builders import slider_crank
-
     from clearance.bench.scenarios import write_report
     from clearance.bench.speed_error import Scenario, Setting, run_speed_error
     from clearance.bench.speed_error_report import compare_scenario
+    from clearance.builders import slider_crank
 
     monkeypatch.setenv("CLEARANCE_CACHE_DIR", str(tmp_path / "cache"))
-    sc = Scenario("sc", functools.partial(slider_crank, radial_clearance=0.25e-3), 3, 0.25,
-                  (Setting(5e-6, 36), Setting(2e-6, 36)), blocks=2, output_interval=2e-6)
+    sc = Scenario(
+        "sc",
+        functools.partial(slider_crank, radial_clearance=0.25e-3),
+        3,
+        0.25,
+        (Setting(5e-6, 36), Setting(2e-6, 36)),
+        blocks=2,
+        output_interval=2e-6,
+    )
     out = tmp_path / "bench"
     with ThreadPoolExecutor(1) as ex:
         run_speed_error([sc], out, executor=ex, progress=False)

@@ -12,12 +12,12 @@ import math
 
 import numpy as np
 import pytest
+
+from clearance import ContactLaw, ModelOptions, simulate
 from clearance.builders import rpm, slider_crank, ten_bar
 from clearance.builders.multiloop import TEN_BAR_INFO
 from clearance.contact_calibration import MIN_APPROACH_SPEED, lankarani_nikravesh
 from clearance.reference import ReferenceSystem, run_reference, simulate_system
-
-from clearance import ContactLaw, ModelOptions, simulate
 from clearance.run.preparation import TimeStepError
 
 FIRST_IMPACT = 0.6e-3  # s: covers the first impact of every slider-crank case below
@@ -172,8 +172,9 @@ def test_journal_starting_off_centre_in_contact(mode):
     # along the guide, exceeds the explicit step's limit (c h / m < 2) and the force chatters
     h = 0.5e-6 if mode == "exact_ln" else 1e-6
     mech = slider_crank()
-    r = simulate(mech, duration=50e-6, options=ModelOptions(contact_mode=mode, timestep=h),
-                 initial_eccentricity=PRESSED_START)
+    r = simulate(
+        mech, duration=50e-6, options=ModelOptions(contact_mode=mode, timestep=h), initial_eccentricity=PRESSED_START
+    )
     jr = r.joints["rod_slider"]
     assert jr.eccentricity[0] == pytest.approx(PRESSED_START["rod_slider"], abs=1e-12)  # Gauss-Newton to 1e-12 m
     assert np.all(np.isfinite(jr.contact_force))
@@ -187,9 +188,13 @@ def test_journal_starting_off_centre_in_contact(mode):
         # Exact LN is the law itself, with the approach speed of a contact present at t = 0
         # recorded as the shared floor: F = K delta^1.5 (1 + chi delta_dot / MIN_APPROACH_SPEED)
         # row by row. At this floor the damping term is not small: +30 % at delta_dot = 2 mm/s.
-        law = lankarani_nikravesh(delta, _radial_rate(jr), MIN_APPROACH_SPEED,
-                                  stiffness=r.metadata["sizing"]["rod_slider"]["stiffness"],
-                                  restitution=mech.joint("rod_slider").clearance.restitution)
+        law = lankarani_nikravesh(
+            delta,
+            _radial_rate(jr),
+            MIN_APPROACH_SPEED,
+            stiffness=r.metadata["sizing"]["rod_slider"]["stiffness"],
+            restitution=mech.joint("rod_slider").clearance.restitution,
+        )
         # 1e-9: the rows carry the imposed force to round-off (measured 1e-15 relative)
         np.testing.assert_allclose(jr.force_magnitude, law, rtol=1e-9, atol=1e-9 * hertz.max())
     else:
@@ -209,8 +214,13 @@ def test_exact_ln_start_in_contact_matches_the_reference_solver(side):
     mech = slider_crank()
     c, d0 = 0.5e-3, 10e-6
     start = (side * (c + d0), 0.0)
-    r = simulate(mech, duration=40e-6, options=ModelOptions(contact_mode="exact_ln", timestep=0.5e-6),
-                 initial_eccentricity={"rod_slider": start}, output_interval=1e-6)
+    r = simulate(
+        mech,
+        duration=40e-6,
+        options=ModelOptions(contact_mode="exact_ln", timestep=0.5e-6),
+        initial_eccentricity={"rod_slider": start},
+        output_interval=1e-6,
+    )
     system = ReferenceSystem(mech)
     q0, qd0 = system.initial_state()
     q0[3 * system.link_names.index("slider")] -= start[0]  # the journal (slider) moved as simulate moves it

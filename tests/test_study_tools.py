@@ -6,6 +6,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 import pytest
+
 from clearance.analysis.metrics.comparisons import (
     joint_distances,
     linear_fit,
@@ -16,7 +17,6 @@ from clearance.analysis.metrics.comparisons import (
 from clearance.analysis.sweeps.run_store import RunSpec, run_batch
 from clearance.analysis.sweeps.sweep import KeywordFactory
 from clearance.builders import rpm, slider_crank, watt_six_bar
-
 from clearance.options import ModelOptions
 from clearance.results import JointResult, SimulationResult
 
@@ -24,10 +24,14 @@ from clearance.results import JointResult, SimulationResult
 def _series(v: np.ndarray, t: np.ndarray) -> SimulationResult:
     n = len(t)
     return SimulationResult(
-        times=t, outputs={"x": np.cumsum(v) * (t[1] - t[0]), "x_vel": v, "x_acc": np.gradient(v, t)},
+        times=t,
+        outputs={"x": np.cumsum(v) * (t[1] - t[0]), "x_vel": v, "x_acc": np.gradient(v, t)},
         joints={"j": JointResult(np.zeros((n, 2)), np.zeros((n, 2)), np.full(n, -1e-6), np.zeros((n, 2)))},
-        drive_angle=(2 * np.pi * t)[:, None], drive_speed=np.full((n, 1), 2 * np.pi), drive_torque=np.zeros((n, 1)),
-        link_poses=np.zeros((n, 1, 3)), closure_violation=np.zeros(n),
+        drive_angle=(2 * np.pi * t)[:, None],
+        drive_speed=np.full((n, 1), 2 * np.pi),
+        drive_torque=np.zeros((n, 1)),
+        link_poses=np.zeros((n, 1, 3)),
+        closure_violation=np.zeros(n),
     )
 
 
@@ -109,15 +113,30 @@ def test_comparison_figures_write_pngs(tmp_path):
 
     t = np.linspace(0, 1, 500)
     r = _series(np.sin(2 * np.pi * t), t)
-    plot_trends([TrendPanel({"a": ([1, 2, 3], [1, 4, 9], [0.1, 0.2, 0.3])}, "x [mm]", "y [N]",
-                            reference={"paper": ([2], [5])}, logx=True)], title="t", path=tmp_path / "trend.png")
+    plot_trends(
+        [
+            TrendPanel(
+                {"a": ([1, 2, 3], [1, 4, 9], [0.1, 0.2, 0.3])},
+                "x [mm]",
+                "y [N]",
+                reference={"paper": ([2], [5])},
+                logx=True,
+            )
+        ],
+        title="t",
+        path=tmp_path / "trend.png",
+    )
     plot_output_overlay({"ideal": r, "other": r}, "x", window=(0.2, 0.8), path=tmp_path / "overlay.png")
-    plot_orbit_phase_panels([OrbitPanel(r, "j", 1e-4, "one", period=0.5), OrbitPanel(r, "j", 1e-4, "two", period=0.5)],
-                            path=tmp_path / "orbits.png")
+    plot_orbit_phase_panels(
+        [OrbitPanel(r, "j", 1e-4, "one", period=0.5), OrbitPanel(r, "j", 1e-4, "two", period=0.5)],
+        path=tmp_path / "orbits.png",
+    )
     with pytest.raises(ValueError, match="period"):
         plot_orbit_phase_panels([OrbitPanel(r, "j", 1e-4, "no period")])
     pts = np.column_stack([np.cos(np.arange(30) * 0.7), np.sin(np.arange(30) * 0.7)]) * 1e-5
-    plot_poincare_panels([PoincarePanel(pts, ("j.ex", "j.ey"), classify_poincare(pts), label="c = 0.1 mm")],
-                         path=tmp_path / "poincare.png")
+    plot_poincare_panels(
+        [PoincarePanel(pts, ("j.ex", "j.ey"), classify_poincare(pts), label="c = 0.1 mm")],
+        path=tmp_path / "poincare.png",
+    )
     for name in ("trend", "overlay", "orbits", "poincare"):
         assert (tmp_path / f"{name}.png").read_bytes()[:4] == b"\x89PNG"

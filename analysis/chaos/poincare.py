@@ -49,8 +49,12 @@ __all__ = [
     "RunSection",
 ]
 
-_JOINT_PARTS = {"ex": ("eccentricity", 0), "ey": ("eccentricity", 1), "vx": ("eccentricity_rate", 0),
-                "vy": ("eccentricity_rate", 1)}
+_JOINT_PARTS = {
+    "ex": ("eccentricity", 0),
+    "ey": ("eccentricity", 1),
+    "vx": ("eccentricity_rate", 0),
+    "vy": ("eccentricity_rate", 1),
+}
 
 
 class Regime(enum.Enum):

@@ -13,16 +13,16 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from clearance.analysis.chaos.poincare import PhasePortrait, PoincareClassification  # noqa: E402
-from clearance.analysis.figures.plots import save_figure  # noqa: E402
-from clearance.analysis.metrics.response import ContactMode, JointContactModes  # noqa: E402
-from clearance.analysis.metrics.statistics import DeviationStatistics, deviation_series  # noqa: E402
-from clearance.analysis.sweeps.bifurcation import BifurcationDiagram  # noqa: E402
-from clearance.analysis.sweeps.criticality import CriticalityRanking  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from clearance.results import SimulationResult  # noqa: E402
+from clearance.analysis.chaos.poincare import PhasePortrait, PoincareClassification
+from clearance.analysis.figures.plots import save_figure
+from clearance.analysis.metrics.response import ContactMode, JointContactModes
+from clearance.analysis.metrics.statistics import DeviationStatistics, deviation_series
+from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
+from clearance.analysis.sweeps.criticality import CriticalityRanking
+from clearance.results import SimulationResult
 
 __all__ = [
     "quantity_label",
@@ -34,9 +34,13 @@ __all__ = [
     "plot_poincare",
 ]
 
-_PARAMS = {"radial_clearance": ("radial clearance", "mm", 1e3), "clearance": ("radial clearance", "mm", 1e3),
-           "crank_speed": ("crank speed", "rpm", 30 / np.pi), "speed": ("crank speed", "rpm", 30 / np.pi),
-           "crank2_speed": ("crank 2 speed", "rad/s", 1.0)}
+_PARAMS = {
+    "radial_clearance": ("radial clearance", "mm", 1e3),
+    "clearance": ("radial clearance", "mm", 1e3),
+    "crank_speed": ("crank speed", "rpm", 30 / np.pi),
+    "speed": ("crank speed", "rpm", 30 / np.pi),
+    "crank2_speed": ("crank 2 speed", "rad/s", 1.0),
+}
 _MODE_COLOURS = {ContactMode.IMPACT: "C3", ContactMode.CONTINUOUS: "C0"}
 
 
@@ -51,9 +55,14 @@ def quantity_label(name: str) -> tuple[str, str, float]:
         return _PARAMS[name]
     joint, _, part = name.rpartition(".")
     if joint:
-        units = {"ex": ("eccentricity x", "µm", 1e6), "ey": ("eccentricity y", "µm", 1e6),
-                 "e": ("|eccentricity|", "µm", 1e6), "vx": ("eccentricity rate x", "mm/s", 1e3),
-                 "vy": ("eccentricity rate y", "mm/s", 1e3), "force": ("contact force", "N", 1.0)}
+        units = {
+            "ex": ("eccentricity x", "µm", 1e6),
+            "ey": ("eccentricity y", "µm", 1e6),
+            "e": ("|eccentricity|", "µm", 1e6),
+            "vx": ("eccentricity rate x", "mm/s", 1e3),
+            "vy": ("eccentricity rate y", "mm/s", 1e3),
+            "force": ("contact force", "N", 1.0),
+        }
         if part in units:
             lab, unit, scale = units[part]
             return f"{joint} {lab}", unit, scale
@@ -100,14 +109,18 @@ def plot_deviation(
     a2.set_ylabel("samples")
     a2.legend(fontsize=8)
     a2.set_title(f"KS = {stats.ks_statistic:.3g}, F = {stats.f_statistic:.4g}", fontsize=9)
-    fig.suptitle(f"{output}: mean deviation {stats.mean_deviation * scale:.3g} {unit}, "
-                 f"RMS {stats.rms_deviation * scale:.3g} {unit} (from t = {stats.window_start * 1e3:.3g} ms)")
+    fig.suptitle(
+        f"{output}: mean deviation {stats.mean_deviation * scale:.3g} {unit}, "
+        f"RMS {stats.rms_deviation * scale:.3g} {unit} (from t = {stats.window_start * 1e3:.3g} ms)"
+    )
     if path is not None:
         save_figure(fig, path)
     return fig
 
 
-def plot_contact_modes(result: SimulationResult, modes: list[JointContactModes], *, path: str | Path | None = None) -> plt.Figure:
+def plot_contact_modes(
+    result: SimulationResult, modes: list[JointContactModes], *, path: str | Path | None = None
+) -> plt.Figure:
     """Contact-force magnitude per joint with each contact event shaded by its mode.
 
     Args:
@@ -123,10 +136,14 @@ def plot_contact_modes(result: SimulationResult, modes: list[JointContactModes],
         for e in m.events:
             lab = None if e.mode in seen else e.mode.value.replace("_", " ")
             seen.add(e.mode)
-            ax.axvspan(e.start * 1e3, (e.start + e.duration) * 1e3, color=_MODE_COLOURS[e.mode], alpha=0.25, lw=0, label=lab)
+            ax.axvspan(
+                e.start * 1e3, (e.start + e.duration) * 1e3, color=_MODE_COLOURS[e.mode], alpha=0.25, lw=0, label=lab
+            )
         fr = ", ".join(f"{k.value.replace('_', ' ')} {v:.0%}" for k, v in m.fractions.items())
-        ax.set_title(f"{m.joint}: {fr}; impulse {m.impulse:.3g} N s; continuous if ≥ {m.continuous_after * 1e3:.3g} ms",
-                     fontsize=9)
+        ax.set_title(
+            f"{m.joint}: {fr}; impulse {m.impulse:.3g} N s; continuous if ≥ {m.continuous_after * 1e3:.3g} ms",
+            fontsize=9,
+        )
         ax.set_ylabel("force [N]")
         ax.legend(loc="upper right", fontsize=8)
         ax.grid(alpha=0.3)
@@ -147,12 +164,15 @@ def plot_phase_portrait(
         path: PNG path to save to.
     """
     label, unit, scale = quantity_label(portrait.name)
-    vlab, vunit, vscale = quantity_label(f"{portrait.name}_vel" if "." not in portrait.name
-                                         else portrait.name.replace(".e", ".v"))
+    vlab, vunit, vscale = quantity_label(
+        f"{portrait.name}_vel" if "." not in portrait.name else portrait.name.replace(".e", ".v")
+    )
     fig, ax = plt.subplots(figsize=(7, 5.5))
     ax.plot(portrait.position * scale, portrait.velocity * vscale, lw=0.4, color="0.4", label="trajectory")
     if section is not None and len(section):
-        ax.plot(section[:, 0] * scale, section[:, 1] * vscale, "o", ms=3.5, color="C3", label="Poincaré points (t = kT)")
+        ax.plot(
+            section[:, 0] * scale, section[:, 1] * vscale, "o", ms=3.5, color="C3", label="Poincaré points (t = kT)"
+        )
     ax.set_xlabel(f"{label} [{unit}]")
     ax.set_ylabel(f"{vlab} [{vunit}]")
     ax.set_title(f"phase portrait of {portrait.name}")
@@ -191,8 +211,15 @@ def plot_poincare(
         fig = ax.figure
     if trajectory is not None:
         ax.plot(trajectory[:, 0] * s1, trajectory[:, 1] * s2, lw=0.3, color="0.7", label="trajectory")
-    sc = ax.scatter(points[:, 0] * s1, points[:, 1] * s2, c=np.arange(len(points)), s=12, cmap="viridis",
-                    label="section points", zorder=3)
+    sc = ax.scatter(
+        points[:, 0] * s1,
+        points[:, 1] * s2,
+        c=np.arange(len(points)),
+        s=12,
+        cmap="viridis",
+        label="section points",
+        zorder=3,
+    )
     fig.colorbar(sc, ax=ax, label="drive period index k")
     if u1 == u2:
         ax.set_aspect("equal", adjustable="datalim")
@@ -203,7 +230,11 @@ def plot_poincare(
     if classification is not None:
         c = classification
         title += f": {c.regime.value.replace('_', '-')}"
-        title += f" (period {c.period})" if c.period else f" (divergence {c.divergence:.2f}, D2 {c.correlation_dimension:.2f})"
+        title += (
+            f" (period {c.period})"
+            if c.period
+            else f" (divergence {c.divergence:.2f}, D2 {c.correlation_dimension:.2f})"
+        )
     ax.set_title(title, fontsize=10)
     ax.legend(loc="upper right", fontsize=8)
     ax.grid(alpha=0.3)

@@ -16,15 +16,15 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
-from clearance.analysis.chaos.poincare import PoincareClassification  # noqa: E402
-from clearance.analysis.figures.analysis_figures import plot_poincare, quantity_label  # noqa: E402
-from clearance.analysis.figures.plots import save_figure  # noqa: E402
-from clearance.analysis.sweeps.criticality import CriticalityRanking  # noqa: E402
-from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
+from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
 
-from clearance.results import SimulationResult  # noqa: E402
+from clearance.analysis.chaos.poincare import PoincareClassification
+from clearance.analysis.figures.analysis_figures import plot_poincare, quantity_label
+from clearance.analysis.figures.plots import save_figure
+from clearance.analysis.sweeps.criticality import CriticalityRanking
+from clearance.results import SimulationResult
 
 __all__ = [
     "OrbitPanel",
@@ -135,8 +135,9 @@ def plot_output_overlay(
     """
     fig, axes = plt.subplots(3, 1, figsize=(9.5, 8.5), sharex=True)
     first = next(iter(runs.values()))
-    for ax, key, what in zip(axes, (output, f"{output}_vel", f"{output}_acc"),
-                             ("displacement", "velocity", "acceleration")):
+    for ax, key, what in zip(
+        axes, (output, f"{output}_vel", f"{output}_acc"), ("displacement", "velocity", "acceleration")
+    ):
         _, unit, scale = quantity_label(key)
         rel = relative and key == output
         if rel:

@@ -74,8 +74,7 @@ def plot_linkage(
     links = {lk.name: lk for lk in mechanism.links}
     colour = {lk.name: _COLOURS[i % len(_COLOURS)] for i, lk in enumerate(mechanism.moving_links)}
     world = {
-        name: {p: link_point_world(mechanism, q, name, xy) for p, xy in lk.points.items()}
-        for name, lk in links.items()
+        name: {p: link_point_world(mechanism, q, name, xy) for p, xy in lk.points.items()} for name, lk in links.items()
     }
     paths: dict[str, np.ndarray] = {}
     if trace:
@@ -92,7 +91,7 @@ def plot_linkage(
     segments: list[tuple[np.ndarray, np.ndarray]] = []
 
     # joint paths
-    for name, path in paths.items():
+    for path in paths.values():
         if np.ptp(path, axis=0).max() > 1e-9:
             ax.plot(path[:, 0], path[:, 1], lw=0.6, ls=":", color="0.55", zorder=1)
     # prismatic guides and sliders
@@ -100,8 +99,12 @@ def plot_linkage(
         if j.kind is not JointType.PRISMATIC:
             continue
         pa = world[j.link_b][j.point_b]
-        th = 0.0 if j.link_a == mechanism.ground else q[3 * [m.name for m in mechanism.moving_links].index(j.link_a) + 2]
-        ax_w = np.array([math.cos(th) * j.axis[0] - math.sin(th) * j.axis[1], math.sin(th) * j.axis[0] + math.cos(th) * j.axis[1]])
+        th = (
+            0.0 if j.link_a == mechanism.ground else q[3 * [m.name for m in mechanism.moving_links].index(j.link_a) + 2]
+        )
+        ax_w = np.array(
+            [math.cos(th) * j.axis[0] - math.sin(th) * j.axis[1], math.sin(th) * j.axis[0] + math.cos(th) * j.axis[1]]
+        )
         s = (paths[j.name] - pa) @ ax_w if j.name in paths else np.array([0.0])
         lo, hi = s.min() - 0.12 * span, s.max() + 0.12 * span
         nrm = np.array([-ax_w[1], ax_w[0]])
@@ -124,9 +127,21 @@ def plot_linkage(
             w, h = 0.09 * span, 0.07 * span
             pj = next(j for j in mechanism.joints if j.kind is JointType.PRISMATIC and j.link_b == lk.name)
             c = world[lk.name][pj.point_b]
-            corner = c + np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]]) @ np.array([-w / 2, -h / 2])
-            ax.add_patch(Rectangle(tuple(corner), w, h, angle=math.degrees(th), facecolor=to_rgba(colour[lk.name], 0.35),
-                                   edgecolor=colour[lk.name], lw=1.5, zorder=3))
+            corner = c + np.array([[math.cos(th), -math.sin(th)], [math.sin(th), math.cos(th)]]) @ np.array(
+                [-w / 2, -h / 2]
+            )
+            ax.add_patch(
+                Rectangle(
+                    tuple(corner),
+                    w,
+                    h,
+                    angle=math.degrees(th),
+                    facecolor=to_rgba(colour[lk.name], 0.35),
+                    edgecolor=colour[lk.name],
+                    lw=1.5,
+                    zorder=3,
+                )
+            )
             segments.append((c - np.array([w / 2, 0]), c + np.array([w / 2, 0])))
             for p in pts:
                 if np.linalg.norm(p - c) > 1e-12:
@@ -134,8 +149,16 @@ def plot_linkage(
                     segments.append((c, p))
         elif len(pts) >= 3:
             hull = _hull_order(pts)
-            ax.add_patch(Polygon(hull, closed=True, facecolor=to_rgba(colour[lk.name], 0.22),
-                                 edgecolor=colour[lk.name], lw=2.5, zorder=3))
+            ax.add_patch(
+                Polygon(
+                    hull,
+                    closed=True,
+                    facecolor=to_rgba(colour[lk.name], 0.22),
+                    edgecolor=colour[lk.name],
+                    lw=2.5,
+                    zorder=3,
+                )
+            )
             segments += [(hull[k], hull[(k + 1) % len(hull)]) for k in range(len(hull))]
         else:
             ax.plot(pts[:, 0], pts[:, 1], color=colour[lk.name], lw=4, solid_capstyle="round", zorder=3)
@@ -150,10 +173,20 @@ def plot_linkage(
         if mechanism.ground in (j.link_a, j.link_b):
             tri = np.array([p, p + [-1.6 * r_joint, -2.6 * r_joint], p + [1.6 * r_joint, -2.6 * r_joint]])
             ax.add_patch(Polygon(tri, closed=True, facecolor="0.85", edgecolor="k", lw=1.0, zorder=2))
-            ax.plot([p[0] - 2.4 * r_joint, p[0] + 2.4 * r_joint], [p[1] - 2.6 * r_joint] * 2, color="k", lw=1.2, zorder=2)
+            ax.plot(
+                [p[0] - 2.4 * r_joint, p[0] + 2.4 * r_joint], [p[1] - 2.6 * r_joint] * 2, color="k", lw=1.2, zorder=2
+            )
         clear = j.clearance is not None
-        ax.add_patch(plt.Circle(tuple(p), r_joint * (1.35 if clear else 1.0), facecolor="white",
-                                edgecolor="#d62728" if clear else "k", lw=2.0 if clear else 1.2, zorder=5))
+        ax.add_patch(
+            plt.Circle(
+                tuple(p),
+                r_joint * (1.35 if clear else 1.0),
+                facecolor="white",
+                edgecolor="#d62728" if clear else "k",
+                lw=2.0 if clear else 1.2,
+                zorder=5,
+            )
+        )
     # labels, placed greedily as boxes (size estimated from the font size and the data scale)
     fig_w, fig_h = ax.figure.get_size_inches()
     pos = ax.get_position()
@@ -173,7 +206,7 @@ def plot_linkage(
             for k in range(16):
                 d = np.array([math.cos(k * math.pi / 8 + 0.1), math.sin(k * math.pi / 8 + 0.1)])
                 c = anchor + d * r + np.array([d[0] * hw, d[1] * hh])
-                inside = lambda p, m=0.0: (np.abs(p[:, 0] - c[0]) < hw + m) & (np.abs(p[:, 1] - c[1]) < hh + m)  # noqa: E731
+                inside = lambda p, m=0.0, c=c: (np.abs(p[:, 0] - c[0]) < hw + m) & (np.abs(p[:, 1] - c[1]) < hh + m)  # noqa: E731
                 cost = 0.3 * r / span
                 cost += 3.0 * np.count_nonzero(inside(joints_xy, r_joint)) + 1.0 * np.count_nonzero(inside(samples))
                 for bc, bw, bh in boxes:
@@ -184,16 +217,30 @@ def plot_linkage(
                     best, best_cost = c, cost
         boxes.append((best, hw, hh))
         placed.extend([best + [hw, hh], best - [hw, hh]])
-        ax.annotate(text, xy=tuple(anchor), xytext=tuple(best), ha="center", va="center", zorder=6,
-                    fontsize=size, arrowprops=dict(arrowstyle="-", color="0.5", lw=0.6, shrinkA=0, shrinkB=3), **kw)
+        ax.annotate(
+            text,
+            xy=tuple(anchor),
+            xytext=tuple(best),
+            ha="center",
+            va="center",
+            zorder=6,
+            fontsize=size,
+            arrowprops=dict(arrowstyle="-", color="0.5", lw=0.6, shrinkA=0, shrinkB=3),
+            **kw,
+        )
 
     if joint_names:
         for j in mechanism.joints:
             anchor = jpos.get(j.name, world[j.link_b][j.point_b])
             label = j.name + (" (c)" if j.clearance is not None else "")
-            place(anchor, label, 9.0, fontweight="bold",
-                  color="#d62728" if j.clearance is not None else "k",
-                  bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8))
+            place(
+                anchor,
+                label,
+                9.0,
+                fontweight="bold",
+                color="#d62728" if j.clearance is not None else "k",
+                bbox=dict(boxstyle="round,pad=0.15", fc="white", ec="none", alpha=0.8),
+            )
     if link_names:
         for lk in mechanism.moving_links:
             pts = np.array(list(world[lk.name].values()))

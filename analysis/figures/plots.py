@@ -12,13 +12,12 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
+import matplotlib.pyplot as plt
+import numpy as np
 
-from clearance.results import SimulationResult, atomic_write_bytes  # noqa: E402
+from clearance.results import SimulationResult, atomic_write_bytes
 
 __all__ = ["plot_response", "plot_contact_force", "plot_orbit", "save_figure"]
-
 
 
 def save_figure(fig: plt.Figure, path: str | Path, *, dpi: int = 130) -> Path:

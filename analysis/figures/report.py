@@ -10,6 +10,7 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+
 from clearance.analysis.chaos.poincare import (
     classify_poincare,
     phase_portrait,
@@ -22,7 +23,6 @@ from clearance.analysis.metrics.response import compare_response, contact_modes
 from clearance.analysis.metrics.statistics import deviation_statistics, drive_period
 from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
 from clearance.analysis.sweeps.criticality import CriticalityRanking, ranking_markdown
-
 from clearance.results import SimulationResult, atomic_write_text
 
 __all__ = ["write_report", "joint_sections"]
@@ -99,53 +99,90 @@ def write_report(
     md = result.metadata
     lines = [f"# {title or md.get('mechanism', 'run')}: response with clearance", ""]
     lines += ["| item | value |", "|---|---|"]
-    for key in ("mechanism", "solver", "time_step", "integrator", "segments", "journal_geom", "segment_geom",
-                "contact_mode", "wall_time_s", "mujoco_version"):
+    for key in (
+        "mechanism",
+        "solver",
+        "time_step",
+        "integrator",
+        "segments",
+        "journal_geom",
+        "segment_geom",
+        "contact_mode",
+        "wall_time_s",
+        "mujoco_version",
+    ):
         if key in md:
             lines.append(f"| {key} | {md[key]} |")
-    lines.append(f"| simulated time | {result.times[-1] * 1e3:.4g} ms ({result.times[-1] / period:.3g} drive periods) |")
+    lines.append(
+        f"| simulated time | {result.times[-1] * 1e3:.4g} ms ({result.times[-1] / period:.3g} drive periods) |"
+    )
     lines.append("")
 
     lines += ["## Response against the ideal mechanism", ""]
     plots.plot_response(result, ideal, output, angular=angular, path=out / "response_vs_ideal.png")
     lines += ["![response](response_vs_ideal.png)", ""]
-    lines += ["| quantity | lag [ms] | max | at [ms] | min | at [ms] | ideal max | ideal min | peak ratio |",
-              "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+    lines += [
+        "| quantity | lag [ms] | max | at [ms] | min | at [ms] | ideal max | ideal min | peak ratio |",
+        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     for key in (output, f"{output}_vel", f"{output}_acc"):
         if key not in result.outputs:
             continue
         c = compare_response(result, ideal, key, skip=skip)
         p, p0 = c.peaks, c.ideal_peaks
-        lines.append(f"| {key} | {c.lag * 1e3:.4g} | {_g(p.max_value)} | {p.max_time * 1e3:.4g} | {_g(p.min_value)} | "
-                     f"{p.min_time * 1e3:.4g} | {_g(p0.max_value)} | {_g(p0.min_value)} | {c.peak_ratio:.3g} |")
-    lines += ["", "Values in SI units (m, m/s, m/s² or rad, rad/s, rad/s²); lag > 0: the output is later "
-              "than the ideal one (cross-correlation peak).", ""]
+        lines.append(
+            f"| {key} | {c.lag * 1e3:.4g} | {_g(p.max_value)} | {p.max_time * 1e3:.4g} | {_g(p.min_value)} | "
+            f"{p.min_time * 1e3:.4g} | {_g(p0.max_value)} | {_g(p0.min_value)} | {c.peak_ratio:.3g} |"
+        )
+    lines += [
+        "",
+        "Values in SI units (m, m/s, m/s² or rad, rad/s, rad/s²); lag > 0: the output is later "
+        "than the ideal one (cross-correlation peak).",
+        "",
+    ]
 
     lines += ["## Deviation statistics", ""]
     st = deviation_statistics(result, ideal, output, skip=skip)
     figures.plot_deviation(result, ideal, output, st, path=out / "deviation.png")
     lines += ["| statistic | value |", "|---|---:|"]
     lines += [f"| {k} | {_g(v) if isinstance(v, float) else v} |" for k, v in st.as_dict().items()]
-    lines += ["", f"Window from t = {st.window_start * 1e3:.4g} ms (start-up transient skipped). Samples are "
-              "autocorrelated: compare p-values between runs, not as absolute levels.", "",
-              "![deviation](deviation.png)", ""]
+    lines += [
+        "",
+        f"Window from t = {st.window_start * 1e3:.4g} ms (start-up transient skipped). Samples are "
+        "autocorrelated: compare p-values between runs, not as absolute levels.",
+        "",
+        "![deviation](deviation.png)",
+        "",
+    ]
 
     if result.joints:
         lines += ["## Contact at the clearance joints", ""]
         modes = [contact_modes(result, j) for j in result.joints]
         plots.plot_contact_force(result, path=out / "contact_force.png")
         figures.plot_contact_modes(result, modes, path=out / "contact_modes.png")
-        lines += ["| joint | dominant mode | free flight | impact | continuous | events | impulse [N s] | peak force [N] "
-                  "| p95 force [N] | impacts |", "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
+        lines += [
+            "| joint | dominant mode | free flight | impact | continuous | events | impulse [N s] | peak force [N] "
+            "| p95 force [N] | impacts |",
+            "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        ]
         for m in modes:
             f = {k.value: v for k, v in m.fractions.items()}
-            lines.append(f"| {m.joint} | {m.dominant.value} | {f['free_flight']:.1%} | {f['impact']:.1%} | "
-                         f"{f['continuous_contact']:.1%} | {len(m.events)} | {m.impulse:.4g} | "
-                         f"{m.summary.peak_force:.4g} | {m.summary.p95_force:.4g} | {m.summary.impacts} |")
+            lines.append(
+                f"| {m.joint} | {m.dominant.value} | {f['free_flight']:.1%} | {f['impact']:.1%} | "
+                f"{f['continuous_contact']:.1%} | {len(m.events)} | {m.impulse:.4g} | "
+                f"{m.summary.peak_force:.4g} | {m.summary.p95_force:.4g} | {m.summary.impacts} |"
+            )
         thr = modes[0].continuous_after * 1e3
-        lines += ["", f"A contact event (penetration > 0 without a break) lasting at least {thr:.3g} ms (5 % of the "
-                  "drive period) is continuous contact, a shorter one an impact.", "",
-                  "![contact force](contact_force.png)", "", "![contact modes](contact_modes.png)", ""]
+        lines += [
+            "",
+            f"A contact event (penetration > 0 without a break) lasting at least {thr:.3g} ms (5 % of the "
+            "drive period) is continuous contact, a shorter one an impact.",
+            "",
+            "![contact force](contact_force.png)",
+            "",
+            "![contact modes](contact_modes.png)",
+            "",
+        ]
         for j in result.joints:
             plots.plot_orbit(result, j, _clearance_of(result, j), path=out / f"orbit_{j}.png")
             lines += [f"![orbit {j}](orbit_{j}.png)", ""]
@@ -163,25 +200,37 @@ def write_report(
         vals = np.column_stack([quantity_series(result, n)[after] for n in names])
         scale = float(np.sqrt(np.mean(np.sum((vals - vals.mean(axis=0)) ** 2, axis=1))))
         cl = classify_poincare(pts, scale=scale)
-        lines.append(f"| {names[0]} / {names[1]} | {cl.n_points} | {cl.regime.value} | {cl.period} | "
-                     f"{cl.divergence:.3g} | {cl.correlation_dimension:.3g} |")
+        lines.append(
+            f"| {names[0]} / {names[1]} | {cl.n_points} | {cl.regime.value} | {cl.period} | "
+            f"{cl.divergence:.3g} | {cl.correlation_dimension:.3g} |"
+        )
         if names[1].endswith("_vel"):
             figures.plot_phase_portrait(phase_portrait(result, names[0]), section=pts, path=out / f"phase_{k}.png")
             phase_pngs.append((k, f"phase_{k}.png"))
         else:
             figures.plot_poincare(pts, names, cl, trajectory=vals, path=out / f"poincare_{k}.png")
             poincare_pngs.append((k, f"poincare_{k}.png"))
-    lines += ["", "Regime criterion: `clearance.analysis.chaos.poincare` (distinct points within 1 % of the motion's RMS "
-              "size, then nearest-neighbour divergence of the section map). Few periods give few points: the "
-              "regime of a short run is indicative only.", ""]
+    lines += [
+        "",
+        "Regime criterion: `clearance.analysis.chaos.poincare` (distinct points within 1 % of the motion's RMS "
+        "size, then nearest-neighbour divergence of the section map). Few periods give few points: the "
+        "regime of a short run is indicative only.",
+        "",
+    ]
     lines += [f"![section {k}]({name})" for k, name in phase_pngs + poincare_pngs]
     lines.append("")
 
     if bifurcation is not None:
         figures.plot_bifurcation(bifurcation, path=out / "bifurcation.png")
         counts = {r: bifurcation.regimes.count(r) for r in dict.fromkeys(bifurcation.regimes)}
-        lines += ["## Bifurcation diagram", "", f"{len(bifurcation.values)} points over {bifurcation.parameter}; "
-                  f"regimes: {counts}.", "", "![bifurcation](bifurcation.png)", ""]
+        lines += [
+            "## Bifurcation diagram",
+            "",
+            f"{len(bifurcation.values)} points over {bifurcation.parameter}; regimes: {counts}.",
+            "",
+            "![bifurcation](bifurcation.png)",
+            "",
+        ]
     if ranking is not None:
         figures.plot_criticality(ranking, path=out / "criticality.png")
         lines += ["## Joint criticality", "", ranking_markdown(ranking), "![criticality](criticality.png)", ""]

@@ -10,9 +10,10 @@ with the reference in two ways:
 * by statistics over a steady-state window (`run_statistics`): per-revolution peak contact
   force, 95th percentile of the in-contact force, fraction of time in contact, impacts per
   revolution, RMS output deviation from the exact ideal mechanism, and the distribution of
-  the journal eccentricity |e| (mean, spread, 10th/50th/90th percentiles). Each statistic carries its own scatter, estimated by
-  batch means: the window is cut into blocks of whole revolutions, the statistic is taken
-  per block, and the standard error of the whole-window value is std(blocks)/sqrt(blocks).
+  the journal eccentricity |e| (mean, spread, 10th/50th/90th percentiles). Each statistic
+  carries its own scatter, estimated by batch means: the window is cut into blocks of whole
+  revolutions, the statistic is taken per block, and the standard error of the
+  whole-window value is std(blocks)/sqrt(blocks).
   That is the run-to-run scatter a statistic of this length has (runs that differ only in
   integration details sample the same attractor independently once they separate).
 
@@ -126,8 +127,7 @@ def first_impact(result: SimulationResult, joint: str) -> FirstImpact | None:
     if hi > b:
         ff[-1] = 0.0
     impulse = float(np.sum(0.5 * (ff[1:] + ff[:-1]) * np.diff(tt)))
-    return FirstImpact(joint, float(t[0]), float(f.max()), float(jr.penetration[a:b].max()), impulse,
-                       float(t[-1]))
+    return FirstImpact(joint, float(t[0]), float(f.max()), float(jr.penetration[a:b].max()), impulse, float(t[-1]))
 
 
 def first_impact_errors(run: FirstImpact | None, ref: FirstImpact | None) -> dict[str, float]:
@@ -249,8 +249,9 @@ def run_statistics(
             for s, d in zip(sel, per):
                 d["rms_deviation"] = float(np.sqrt(np.mean(dev[s] ** 2)))
         out[j] = {
-            k: Statistic(v, float(np.std([d[k] for d in per], ddof=1) / np.sqrt(blocks)), blocks,
-                         tuple(d[k] for d in per))
+            k: Statistic(
+                v, float(np.std([d[k] for d in per], ddof=1) / np.sqrt(blocks)), blocks, tuple(d[k] for d in per)
+            )
             for k, v in whole_stats.items()
         }
     return out

@@ -25,9 +25,9 @@ import enum
 from dataclasses import dataclass
 
 import numpy as np
+
 from clearance.analysis.metrics.statistics import drive_period
 from clearance.analysis.metrics.summary import JointSummary, joint_summary
-
 from clearance.results import SimulationResult
 
 __all__ = [
@@ -171,8 +171,14 @@ def output_peaks(result: SimulationResult, output: str, *, period: float | None 
         cmx.append(y[a]), cmxt.append(t[a]), cmn.append(y[b]), cmnt.append(t[b])
     a, b = int(np.argmax(y)), int(np.argmin(y))
     return OutputPeaks(
-        float(y[a]), float(t[a]), float(y[b]), float(t[b]),
-        np.array(cmx), np.array(cmxt), np.array(cmn), np.array(cmnt),
+        float(y[a]),
+        float(t[a]),
+        float(y[b]),
+        float(t[b]),
+        np.array(cmx),
+        np.array(cmxt),
+        np.array(cmn),
+        np.array(cmnt),
     )
 
 

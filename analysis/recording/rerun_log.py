@@ -95,7 +95,9 @@ class LoggedRun:
             raise TypeError(f"ideal must be a SimulationResult or None (got {type(self.ideal).__name__})")
         p = str(self.prefix).strip("/")
         if p and not all(part and part.replace("_", "").replace("-", "").isalnum() for part in p.split("/")):
-            raise ValueError(f"prefix must be names of letters, digits, '_' or '-' separated by '/' (got {self.prefix!r})")
+            raise ValueError(
+                f"prefix must be names of letters, digits, '_' or '-' separated by '/' (got {self.prefix!r})"
+            )
         object.__setattr__(self, "prefix", p)
         if len(self.result) == 0:
             raise ValueError("result has no rows to log")
@@ -113,7 +115,9 @@ class LoggedRun:
             pts = {}
             for name, arr in self.poincare.items():
                 if name not in self.result.joints:
-                    raise ValueError(f"poincare: '{name}' is not a clearance joint of the result ({self.result.joint_names})")
+                    raise ValueError(
+                        f"poincare: '{name}' is not a clearance joint of the result ({self.result.joint_names})"
+                    )
                 a = np.asarray(arr, dtype=float)
                 if a.ndim != 2 or a.shape[1] != 2:
                     raise ValueError(f"poincare['{name}'] must have shape (k, 2) [m] (got {a.shape})")
@@ -185,13 +189,19 @@ def _drive_names(run: LoggedRun) -> list[str]:
     return [names[k] if k < len(names) else f"drive{k}" for k in range(n)]
 
 
-def _scalars(rec: rr.RecordingStream, path: str, idx: list, values: np.ndarray, name: str, color: int | None = None) -> None:
-    rec.log(path, rr.SeriesLines(names=name, colors=None if color is None else np.array([color], np.uint32)), static=True)
+def _scalars(
+    rec: rr.RecordingStream, path: str, idx: list, values: np.ndarray, name: str, color: int | None = None
+) -> None:
+    rec.log(
+        path, rr.SeriesLines(names=name, colors=None if color is None else np.array([color], np.uint32)), static=True
+    )
     rec.send_columns(path, indexes=idx, columns=rr.Scalars.columns(scalars=np.asarray(values, float)))
 
 
 # -- logging ------------------------------------------------------------------------------
-def log_run(recording: rr.RecordingStream, run: LoggedRun, *, max_rate_hz: float | None = DEFAULT_MAX_RATE_HZ) -> list[str]:
+def log_run(
+    recording: rr.RecordingStream, run: LoggedRun, *, max_rate_hz: float | None = DEFAULT_MAX_RATE_HZ
+) -> list[str]:
     """Log one run into ``recording`` (columns, one `send_columns` per entity).
 
     Args:
@@ -224,28 +234,39 @@ def log_run(recording: rr.RecordingStream, run: LoggedRun, *, max_rate_hz: float
         colors = _force_colors(fmag, float(fmag.max(initial=0.0)))
         base = f"joints/{jname}"
         recording.send_columns(
-            run.path(f"{base}/orbit"), indexes=idx,
+            run.path(f"{base}/orbit"),
+            indexes=idx,
             columns=rr.Points2D.columns(positions=jr.eccentricity * _UM, colors=colors),
         )
         recording.log(run.path(f"{base}/orbit"), rr.Points2D.from_fields(radii=c * _UM / 200), static=True)
         on = np.nonzero(jr.penetration > 0)[0]
         if len(on):
             recording.send_columns(
-                run.path(f"{base}/contact"), indexes=_indexes(res.times, res.drive_angle, on),
+                run.path(f"{base}/contact"),
+                indexes=_indexes(res.times, res.drive_angle, on),
                 columns=rr.Points2D.columns(positions=jr.eccentricity[on] * _UM, colors=colors[on]),
             )
             recording.log(run.path(f"{base}/contact"), rr.Points2D.from_fields(radii=c * _UM / 80), static=True)
         th = np.linspace(0.0, 2 * math.pi, 361)
         recording.log(
             run.path(f"{base}/clearance_circle"),
-            rr.LineStrips2D([np.c_[np.cos(th), np.sin(th)] * c * _UM], colors=np.array([0x404040FF], np.uint32), radii=c * _UM / 400,
-                            labels=[f"c = {c * _UM:.4g} µm"]),
+            rr.LineStrips2D(
+                [np.c_[np.cos(th), np.sin(th)] * c * _UM],
+                colors=np.array([0x404040FF], np.uint32),
+                radii=c * _UM / 400,
+                labels=[f"c = {c * _UM:.4g} µm"],
+            ),
             static=True,
         )
-        logged += [run.path(f"{base}/{e}") for e in ("orbit", "contact", "clearance_circle") if e != "contact" or len(on)]
+        logged += [
+            run.path(f"{base}/{e}") for e in ("orbit", "contact", "clearance_circle") if e != "contact" or len(on)
+        ]
         if run.poincare is not None and jname in run.poincare:
-            recording.log(run.path(f"{base}/poincare"),
-                          rr.Points2D(run.poincare[jname] * _UM, colors=np.array([0xD62728FF], np.uint32), radii=c * _UM / 60), static=True)
+            recording.log(
+                run.path(f"{base}/poincare"),
+                rr.Points2D(run.poincare[jname] * _UM, colors=np.array([0xD62728FF], np.uint32), radii=c * _UM / 60),
+                static=True,
+            )
             logged.append(run.path(f"{base}/poincare"))
         scal(f"{base}/force/magnitude", fmag, f"{tag}{jname} |F| [N]")
         scal(f"{base}/force/x", jr.contact_force[:, 0], f"{tag}{jname} Fx [N]")
@@ -256,14 +277,24 @@ def log_run(recording: rr.RecordingStream, run: LoggedRun, *, max_rate_hz: float
     angular = {o.name: o.kind is OutputKind.ANGLE for o in mech.outputs}
     for o in (name for name in res.outputs if not name.endswith(("_vel", "_acc"))):
         unit = "rad" if angular.get(o) else "m"
-        for kind, suffix, u in (("displacement", "", unit), ("velocity", "_vel", f"{unit}/s"), ("acceleration", "_acc", f"{unit}/s²")):
+        for kind, suffix, u in (
+            ("displacement", "", unit),
+            ("velocity", "_vel", f"{unit}/s"),
+            ("acceleration", "_acc", f"{unit}/s²"),
+        ):
             if o + suffix not in res.outputs:
                 continue
             scal(f"outputs/{o}/{kind}/clearance", res.outputs[o + suffix], f"{tag}{o} {kind} [{u}]")
             if run.ideal is not None and o + suffix in run.ideal.outputs:
                 path = run.path(f"outputs/{o}/{kind}/ideal")
-                _scalars(recording, path, _indexes(run.ideal.times, run.ideal.drive_angle), run.ideal.outputs[o + suffix],
-                         f"{tag}{o} {kind} ideal [{u}]", _GREY)
+                _scalars(
+                    recording,
+                    path,
+                    _indexes(run.ideal.times, run.ideal.drive_angle),
+                    run.ideal.outputs[o + suffix],
+                    f"{tag}{o} {kind} ideal [{u}]",
+                    _GREY,
+                )
                 logged.append(path)
 
     # drives
@@ -296,24 +327,40 @@ def _log_mechanism(recording: rr.RecordingStream, run: LoggedRun, max_rate_hz: f
     n, kmax = len(rows), max(p.shape[1] for p in strips)
     # pad every strip to kmax points by repeating its last point (draws the same), so the
     # strips are one (n * n_links, kmax, 2) array: rerun's numpy fast path, no Python per row
-    flat = np.stack([np.concatenate([p, np.repeat(p[:, -1:], kmax - p.shape[1], axis=1)], axis=1) for p in strips],
-                    axis=1).reshape(-1, kmax, 2)
+    flat = np.stack(
+        [np.concatenate([p, np.repeat(p[:, -1:], kmax - p.shape[1], axis=1)], axis=1) for p in strips], axis=1
+    ).reshape(-1, kmax, 2)
     links_path, joints_path, ground_path = (run.path(f"mechanism/{e}") for e in ("links", "joints", "ground"))
-    recording.send_columns(links_path, indexes=idx,
-                           columns=rr.LineStrips2D.columns(strips=flat).partition([len(strips)] * n))
-    recording.log(links_path, rr.LineStrips2D.from_fields(colors=np.array(colors, np.uint32), labels=labels, radii=0.006 * size * _MM), static=True)
+    recording.send_columns(
+        links_path, indexes=idx, columns=rr.LineStrips2D.columns(strips=flat).partition([len(strips)] * n)
+    )
+    recording.log(
+        links_path,
+        rr.LineStrips2D.from_fields(colors=np.array(colors, np.uint32), labels=labels, radii=0.006 * size * _MM),
+        static=True,
+    )
     jpos, jcol, jlab = [], [], []
     for j in mech.joints:
         jpos.append(pts[j.link_a][:, list(mech.link(j.link_a).points).index(j.point_a)] * _MM)
         jcol.append(0xD62728FF if j.clearance is not None else 0x303030FF)
         jlab.append(j.name)
     jp = np.stack(jpos, axis=1).reshape(-1, 2)
-    recording.send_columns(joints_path, indexes=idx,
-                           columns=rr.Points2D.columns(positions=jp).partition([len(jpos)] * n))
-    recording.log(joints_path, rr.Points2D.from_fields(colors=np.array(jcol, np.uint32), labels=jlab, radii=0.015 * size * _MM,
-                                                       show_labels=False), static=True)
+    recording.send_columns(
+        joints_path, indexes=idx, columns=rr.Points2D.columns(positions=jp).partition([len(jpos)] * n)
+    )
+    recording.log(
+        joints_path,
+        rr.Points2D.from_fields(
+            colors=np.array(jcol, np.uint32), labels=jlab, radii=0.015 * size * _MM, show_labels=False
+        ),
+        static=True,
+    )
     ground = np.array(list(mech.link(mech.ground).points.values()), float).reshape(-1, 2) * _MM
-    recording.log(ground_path, rr.Points2D(ground, colors=np.array([0x000000FF], np.uint32), radii=0.025 * size * _MM), static=True)
+    recording.log(
+        ground_path,
+        rr.Points2D(ground, colors=np.array([0x000000FF], np.uint32), radii=0.025 * size * _MM),
+        static=True,
+    )
     return [links_path, joints_path, ground_path]
 
 
@@ -330,10 +377,12 @@ def make_blueprint(runs: Sequence[LoggedRun]) -> rrb.Blueprint:
         The blueprint.
     """
     runs = list(runs)
-    trail = rrb.VisibleTimeRange(TIME_TIMELINE, start=rrb.TimeRangeBoundary.infinite(),
-                                 end=rrb.TimeRangeBoundary.cursor_relative())
-    trail_rev = rrb.VisibleTimeRange(REV_TIMELINE, start=rrb.TimeRangeBoundary.infinite(),
-                                     end=rrb.TimeRangeBoundary.cursor_relative())
+    trail = rrb.VisibleTimeRange(
+        TIME_TIMELINE, start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.cursor_relative()
+    )
+    trail_rev = rrb.VisibleTimeRange(
+        REV_TIMELINE, start=rrb.TimeRangeBoundary.infinite(), end=rrb.TimeRangeBoundary.cursor_relative()
+    )
     joints = list(dict.fromkeys(j for r in runs for j in r.result.joints))
     orbit_views = [
         rrb.Spatial2DView(
@@ -346,21 +395,34 @@ def make_blueprint(runs: Sequence[LoggedRun]) -> rrb.Blueprint:
         )
         for j in joints
     ]
-    mech_view = rrb.Spatial2DView(name="mechanism [mm]", origin="/",
-                                  contents=[f"+ {r.path('mechanism')}/**" for r in runs])
+    mech_view = rrb.Spatial2DView(
+        name="mechanism [mm]", origin="/", contents=[f"+ {r.path('mechanism')}/**" for r in runs]
+    )
     series = []
     if joints:
-        series.append(rrb.TimeSeriesView(name="contact force [N]", origin="/",
-                                         contents=[f"+ {r.path(f'joints/{j}')}/force/magnitude" for r in runs for j in r.result.joints]))
+        series.append(
+            rrb.TimeSeriesView(
+                name="contact force [N]",
+                origin="/",
+                contents=[f"+ {r.path(f'joints/{j}')}/force/magnitude" for r in runs for j in r.result.joints],
+            )
+        )
     outputs = list(dict.fromkeys(o for r in runs for o in r.result.outputs if not o.endswith(("_vel", "_acc"))))
     for o in outputs:
         for kind in ("displacement", "velocity", "acceleration"):
-            series.append(rrb.TimeSeriesView(name=f"{o} {kind}", origin="/",
-                                             contents=[f"+ {r.path(f'outputs/{o}/{kind}')}/**" for r in runs]))
+            series.append(
+                rrb.TimeSeriesView(
+                    name=f"{o} {kind}", origin="/", contents=[f"+ {r.path(f'outputs/{o}/{kind}')}/**" for r in runs]
+                )
+            )
     speeds = [f"+ {r.path(f'drives/{d}')}/speed" for r in runs for d in _drive_names(r)]
     if speeds:
         series.append(rrb.TimeSeriesView(name="drive speed [rad/s]", origin="/", contents=speeds))
-    left = rrb.Vertical(mech_view, rrb.Grid(*orbit_views) if len(orbit_views) > 1 else orbit_views[0]) if orbit_views else mech_view
+    left = (
+        rrb.Vertical(mech_view, rrb.Grid(*orbit_views) if len(orbit_views) > 1 else orbit_views[0])
+        if orbit_views
+        else mech_view
+    )
     return rrb.Blueprint(
         rrb.Horizontal(left, rrb.Vertical(*series), column_shares=[1, 1]) if series else left,
         rrb.TimePanel(timeline=TIME_TIMELINE),

@@ -16,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
 from clearance.analysis.sweeps.sweep import SweepEvaluation, run_sweep
 
 __all__ = ["BifurcationDiagram", "bifurcation_from_rows", "run_bifurcation"]
@@ -50,7 +51,9 @@ class BifurcationDiagram:
         return np.concatenate(xs), np.concatenate(self.samples)
 
 
-def bifurcation_from_rows(rows: Sequence[Mapping[str, Any]], parameter: str, quantity: str | None = None) -> BifurcationDiagram:
+def bifurcation_from_rows(
+    rows: Sequence[Mapping[str, Any]], parameter: str, quantity: str | None = None
+) -> BifurcationDiagram:
     """Build the diagram from sweep rows (`run_sweep` output or `load_rows`).
 
     Args:
@@ -125,8 +128,9 @@ def run_bifurcation(
     if not (isinstance(sampled, int) and isinstance(periods, int) and 1 <= sampled <= periods - 1):
         raise ValueError(f"sampled must be in [1, periods - 1] (got sampled={sampled!r}, periods={periods!r})")
     points = [{parameter: float(v), **dict(fixed or {})} for v in values]
-    evaluation = SweepEvaluation(poincare=(quantity,), last_periods=sampled, skip_periods=float(periods - sampled),
-                                 ideal=False)
+    evaluation = SweepEvaluation(
+        poincare=(quantity,), last_periods=sampled, skip_periods=float(periods - sampled), ideal=False
+    )
     out = run_sweep(
         points,
         make_mechanism,

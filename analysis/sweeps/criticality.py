@@ -25,9 +25,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from clearance.analysis.sweeps.sweep import SweepEvaluation, run_sweep
 from scipy import stats
 
+from clearance.analysis.sweeps.sweep import SweepEvaluation, run_sweep
 from clearance.model import OutputKind
 
 __all__ = [
@@ -95,7 +95,9 @@ class ClearanceAtJoint:
         return self.builder(**kw)
 
 
-def criticality_points(joints: Sequence[str], clearances: Sequence[float], speeds: Sequence[float]) -> list[dict[str, Any]]:
+def criticality_points(
+    joints: Sequence[str], clearances: Sequence[float], speeds: Sequence[float]
+) -> list[dict[str, Any]]:
     """Grid points ``{"joint", "clearance" [m], "speed" [rad/s]}`` in joint-major order.
 
     Args:
@@ -257,14 +259,21 @@ def ranking_markdown(ranking: CriticalityRanking) -> str:
     ]
     for s in ranking.scores:
         conf = "" if not np.isfinite(s.confidence_above_next) else f"{s.confidence_above_next:.3f}"
-        lines.append(f"| {s.rank} | {s.joint} | {s.score:.4g} | [{s.ci_low:.4g}, {s.ci_high:.4g}] | {s.cells} "
-                     f"| {s.mean_cell_rank:.2f} | {conf} |")
-    lines += ["", f"| joint | clearance [mm] | speed [rpm] | mean deviation [{ranking.deviation_unit}] | s.e. | cycles "
-              "| rank in cell |",
-              "|---|---:|---:|---:|---:|---:|---:|"]
+        lines.append(
+            f"| {s.rank} | {s.joint} | {s.score:.4g} | [{s.ci_low:.4g}, {s.ci_high:.4g}] | {s.cells} "
+            f"| {s.mean_cell_rank:.2f} | {conf} |"
+        )
+    lines += [
+        "",
+        f"| joint | clearance [mm] | speed [rpm] | mean deviation [{ranking.deviation_unit}] | s.e. | cycles "
+        "| rank in cell |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
     for c in ranking.cells:
-        lines.append(f"| {c.joint} | {c.clearance * 1e3:.4g} | {c.speed * 30 / np.pi:.4g} | "
-                     f"{c.mean_deviation * 1e6:.4g} | {c.sem * 1e6:.2g} | {c.cycles} | {c.rank} |")
+        lines.append(
+            f"| {c.joint} | {c.clearance * 1e3:.4g} | {c.speed * 30 / np.pi:.4g} | "
+            f"{c.mean_deviation * 1e6:.4g} | {c.sem * 1e6:.2g} | {c.cycles} | {c.rank} |"
+        )
     for p, e in ranking.failed:
         lines.append(f"\nfailed: {p}: {e}")
     return "\n".join(lines) + "\n"
@@ -318,7 +327,9 @@ def run_criticality(
     kinds = {o.name: o.kind for o in probe.outputs}
     measured = output or next(iter(kinds), None)
     if measured not in kinds:
-        raise ValueError(f"output must be one of the outputs of mechanism '{probe.name}', {list(kinds)} (got {output!r})")
+        raise ValueError(
+            f"output must be one of the outputs of mechanism '{probe.name}', {list(kinds)} (got {output!r})"
+        )
     if joints is None:
         joints = criticality_candidates(probe)
     points = criticality_points(joints, clearances, speeds)

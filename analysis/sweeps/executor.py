@@ -31,7 +31,10 @@ class Pool:
 
 @contextmanager
 def open_executor(
-    executor: Executor | None = None, *, scheduler_address: str | None = None, max_workers: int | None = None,
+    executor: Executor | None = None,
+    *,
+    scheduler_address: str | None = None,
+    max_workers: int | None = None,
 ) -> Iterator[Pool]:
     """The executor of a sweep, for the duration of a ``with`` block.
 
@@ -69,8 +72,9 @@ class Progress:
     Use as a context manager; `step` counts finished tasks and shows a short label.
     """
 
-    def __init__(self, total: int, *, enabled: bool = True, desc: str = "runs", unit: str = "run",
-                 initial: int = 0) -> None:
+    def __init__(
+        self, total: int, *, enabled: bool = True, desc: str = "runs", unit: str = "run", initial: int = 0
+    ) -> None:
         self._bar: Any = None
         if enabled and total:
             from tqdm import tqdm

@@ -25,8 +25,8 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from clearance.analysis.sweeps.executor import Progress, open_executor
 
+from clearance.analysis.sweeps.executor import Progress, open_executor
 from clearance.results import SimulationResult, atomic_write_text
 
 __all__ = ["RunDigest", "RunSpec", "RunStore", "digest_result", "run_batch"]
@@ -115,8 +115,12 @@ def digest_result(name: str, result: SimulationResult, window_start: float) -> R
     outs = {}
     for k, v in result.outputs.items():
         a = np.abs(v)
-        outs[k] = {"max": float(v.max()), "min": float(v.min()), "max_abs": float(a.max()),
-                   "steady_max_abs": float(a[steady].max()) if steady.any() else float("nan")}
+        outs[k] = {
+            "max": float(v.max()),
+            "min": float(v.min()),
+            "max_abs": float(a.max()),
+            "steady_max_abs": float(a[steady].max()) if steady.any() else float("nan"),
+        }
     joints = {}
     for j, jr in result.joints.items():
         d = asdict(joint_summary(result, j))
@@ -128,8 +132,16 @@ def digest_result(name: str, result: SimulationResult, window_start: float) -> R
         d["steady_p95_force"] = float(np.percentile(f[on], 95)) if on.any() else 0.0
         joints[j] = d
     md = result.metadata
-    return RunDigest(name, "ok", "", float(window_start), outs, joints, float(md.get("wall_time_s", np.nan)),
-                     int(md.get("steps", len(result.times))))
+    return RunDigest(
+        name,
+        "ok",
+        "",
+        float(window_start),
+        outs,
+        joints,
+        float(md.get("wall_time_s", np.nan)),
+        int(md.get("steps", len(result.times))),
+    )
 
 
 def _window_start(spec: RunSpec, mechanism: Any) -> float:
@@ -154,7 +166,7 @@ def _run_one(spec: RunSpec, store: str) -> str:
         res = simulate(mech, duration=spec.duration, options=spec.options)
         digest = digest_result(spec.name, res, start)
         res.decimated(spec.keep_every).save(stem)
-    except Exception as err:  # noqa: BLE001 - recorded in the digest, the batch goes on
+    except Exception as err:
         digest = RunDigest(spec.name, "error", f"{type(err).__name__}: {err}", start)
     # the digest is written last: its presence marks a finished run
     atomic_write_text(stem.with_suffix(".digest.json"), json.dumps({"key": spec.key(), **asdict(digest)}, indent=1))
@@ -229,8 +241,10 @@ def run_batch(
         return kept
     # longest first, so the pool is not left waiting on one long run at the end
     order = sorted(todo, key=lambda r: -r.duration / (r.options.timestep if r.options else 1e-6))
-    with (open_executor(executor, max_workers=max_workers) as pool,
-          Progress(len(runs), enabled=progress, initial=len(runs) - len(todo)) as bar):
+    with (
+        open_executor(executor, max_workers=max_workers) as pool,
+        Progress(len(runs), enabled=progress, initial=len(runs) - len(todo)) as bar,
+    ):
         futures = [pool.executor.submit(_run_one, r, str(folder)) for r in order]
         for fut in as_completed(futures):
             fut.result()

@@ -34,9 +34,9 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+
 from clearance.analysis.sweeps.executor import Pool, Progress, open_executor
 from clearance.analysis.sweeps.ideal_runs import ideal_run
-
 from clearance.model import Mechanism
 from clearance.results import atomic_write_text
 
@@ -107,8 +107,13 @@ class SweepEvaluation:
         names = list(self.poincare or (output, f"{output}_vel"))
         sec = run_section(result, names, period=period, skip=skip, last=self.last_periods)
         regime = sec.classification.regime.value if sec.classification else "undetermined"
-        row["poincare"] = {"quantities": names, "times": sec.times.tolist(), "points": sec.points.tolist(),
-                           "scale": sec.scale, "regime": regime}
+        row["poincare"] = {
+            "quantities": names,
+            "times": sec.times.tolist(),
+            "points": sec.points.tolist(),
+            "scale": sec.scale,
+            "regime": regime,
+        }
         return row
 
 
@@ -210,7 +215,7 @@ def evaluate_point(
         t3 = time.perf_counter()
         row.update(evaluation(res, ideal, mech))
         timing["evaluate_s"] = time.perf_counter() - t3
-    except Exception as err:  # noqa: BLE001 - recorded in the row, the sweep goes on
+    except Exception as err:
         row["status"] = "error"
         row["error"] = f"{type(err).__name__}: {err}"
     row = _json_safe(row)
@@ -274,8 +279,12 @@ def _describe(obj: Any) -> str:
     return repr(obj)
 
 
-_SETTING_NAMES = {"mechanism": "mechanism factory", "duration": "duration", "options": "model options",
-                  "evaluation": "evaluation"}
+_SETTING_NAMES = {
+    "mechanism": "mechanism factory",
+    "duration": "duration",
+    "options": "model options",
+    "evaluation": "evaluation",
+}
 
 
 def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str, Any]) -> None:
@@ -285,8 +294,11 @@ def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str,
         old = json.loads(path.read_text())
         if old != manifest:
             old_settings = old.get("settings", {})
-            diffs = [f"{_SETTING_NAMES.get(k, k)}: {old_settings.get(k, '(not recorded)')!r} there, {v!r} now"
-                     for k, v in manifest["settings"].items() if old_settings.get(k) != v]
+            diffs = [
+                f"{_SETTING_NAMES.get(k, k)}: {old_settings.get(k, '(not recorded)')!r} there, {v!r} now"
+                for k, v in manifest["settings"].items()
+                if old_settings.get(k) != v
+            ]
             if old.get("points") != manifest["points"]:
                 diffs.insert(0, f"points: {len(old.get('points', []))} there, {len(points)} now or values differ")
             raise ValueError(
@@ -347,8 +359,12 @@ def run_sweep(
     needs_ideal = bool(getattr(evaluation, "ideal", True))
     out = Path(out_dir)
     (out / "points").mkdir(parents=True, exist_ok=True)
-    settings = {"mechanism": _describe(make_mechanism), "duration": _describe(duration), "options": repr(options),
-                "evaluation": _describe(evaluation)}
+    settings = {
+        "mechanism": _describe(make_mechanism),
+        "duration": _describe(duration),
+        "options": repr(options),
+        "evaluation": _describe(evaluation),
+    }
     _check_manifest(out, _json_safe(pts), settings)
     rows = {r["index"]: r for r in load_rows(out) if 0 <= r["index"] < len(pts)}
     todo = [i for i in range(len(pts)) if i not in rows]
@@ -357,8 +373,10 @@ def run_sweep(
     in_flight: dict[Future[dict[str, Any]], int] = {}
     queue = iter(todo)
     new = 0
-    with (open_executor(executor, scheduler_address=scheduler_address, max_workers=max_workers) as pool,
-          Progress(len(pts), enabled=progress, desc="sweep", unit="point", initial=len(rows)) as bar):
+    with (
+        open_executor(executor, scheduler_address=scheduler_address, max_workers=max_workers) as pool,
+        Progress(len(pts), enabled=progress, desc="sweep", unit="point", initial=len(rows)) as bar,
+    ):
 
         def save(i: int, row: dict[str, Any]) -> None:
             nonlocal new
@@ -368,17 +386,35 @@ def run_sweep(
             new += 1
             bar.step()
 
-        _run_window(pool, 2 * pool.slots, queue, pts, in_flight, save, stop_after, lambda: new,
-                    (make_mechanism, duration, options, evaluation, needs_ideal))
+        _run_window(
+            pool,
+            2 * pool.slots,
+            queue,
+            pts,
+            in_flight,
+            save,
+            stop_after,
+            lambda: new,
+            (make_mechanism, duration, options, evaluation, needs_ideal),
+        )
     if rows and not csv_path.exists():
         atomic_write_text(csv_path, _csv_text([rows[k] for k in sorted(rows)]))
-    return SweepOutcome(out, csv_path, [rows[k] for k in sorted(rows)], len(rows) == len(pts), new,
-                        time.perf_counter() - t0)
+    return SweepOutcome(
+        out, csv_path, [rows[k] for k in sorted(rows)], len(rows) == len(pts), new, time.perf_counter() - t0
+    )
 
 
-def _run_window(pool: Pool, window: int, queue: Iterator[int], pts: list[dict[str, Any]],
-                in_flight: dict[Future[dict[str, Any]], int], save: Callable[[int, dict[str, Any]], None],
-                stop_after: int | None, finished_count: Callable[[], int], args: tuple[Any, ...]) -> None:
+def _run_window(
+    pool: Pool,
+    window: int,
+    queue: Iterator[int],
+    pts: list[dict[str, Any]],
+    in_flight: dict[Future[dict[str, Any]], int],
+    save: Callable[[int, dict[str, Any]], None],
+    stop_after: int | None,
+    finished_count: Callable[[], int],
+    args: tuple[Any, ...],
+) -> None:
     """Keep ``window`` points in flight (twice the slots, so workers never wait) until done or stopped.
 
     Every finished point is saved, also those finishing together with a stop; points already

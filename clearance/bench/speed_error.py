@@ -79,15 +79,19 @@ class Setting:
         """The `ModelOptions` of this setting."""
         from clearance.options import ModelOptions
 
-        return ModelOptions(timestep=self.timestep, segments=self.segments, journal_geom=self.journal_geom,
-                            segment_geom=self.segment_geom, contact_mode=self.contact_mode)
+        return ModelOptions(
+            timestep=self.timestep,
+            segments=self.segments,
+            journal_geom=self.journal_geom,
+            segment_geom=self.segment_geom,
+            contact_mode=self.contact_mode,
+        )
 
     @property
     def label(self) -> str:
         """Human-readable label, e.g. ``calibrated, h = 2 µs, N = rule, sphere/sphere``."""
         n = "rule" if self.segments is None else str(self.segments)
-        return (f"{self.contact_mode}, h = {self.timestep * 1e6:g} µs, N = {n}, "
-                f"{self.journal_geom}/{self.segment_geom}")
+        return f"{self.contact_mode}, h = {self.timestep * 1e6:g} µs, N = {n}, {self.journal_geom}/{self.segment_geom}"
 
     @property
     def key(self) -> str:
@@ -132,10 +136,14 @@ class Scenario:
                 f"{self.skip_revolutions + self.blocks:g} (got {self.revolutions!r})"
             )
         if not self.timing_revolutions > 0:
-            raise ValueError(f"Scenario '{self.name}': timing_revolutions must be > 0 (got {self.timing_revolutions!r})")
+            raise ValueError(
+                f"Scenario '{self.name}': timing_revolutions must be > 0 (got {self.timing_revolutions!r})"
+            )
         keys = [s.key for s in self.settings]
         if len(set(keys)) != len(keys):
-            raise ValueError(f"Scenario '{self.name}': settings repeat ({sorted(k for k in keys if keys.count(k) > 1)})")
+            raise ValueError(
+                f"Scenario '{self.name}': settings repeat ({sorted(k for k in keys if keys.count(k) > 1)})"
+            )
 
 
 def _period(mechanism: Mechanism) -> float:
@@ -145,7 +153,9 @@ def _period(mechanism: Mechanism) -> float:
     return period
 
 
-def ideal_output_function(mechanism: Any, duration: float, *, per_period: int = 2000) -> Callable[[np.ndarray], np.ndarray]:
+def ideal_output_function(
+    mechanism: Any, duration: float, *, per_period: int = 2000
+) -> Callable[[np.ndarray], np.ndarray]:
     """Exact ideal position of the mechanism's first output as a function of time.
 
     Solved by `clearance.kinematics.solve_kinematics` on a grid of ``per_period`` points
@@ -166,8 +176,10 @@ def ideal_output_function(mechanism: Any, duration: float, *, per_period: int = 
     periods = {round(d.period, 12) for d in mechanism.drives if d.kind is DriveKind.CONSTANT_SPEED}
     prescribed = [d for d in mechanism.drives if d.kind is not DriveKind.TORQUE]
     period = _period(mechanism)
-    if len(periods) == 1 and len(prescribed) == len(mechanism.drives) and all(
-        d.kind is DriveKind.CONSTANT_SPEED for d in prescribed
+    if (
+        len(periods) == 1
+        and len(prescribed) == len(mechanism.drives)
+        and all(d.kind is DriveKind.CONSTANT_SPEED for d in prescribed)
     ):
         t = np.linspace(0.0, period, per_period + 1)
         y = solve_kinematics(mechanism, t).outputs[name]
@@ -198,8 +210,13 @@ def accuracy_task(scenario: Scenario, setting: Setting | None, out_dir: str | Pa
 
     out = Path(out_dir)
     key = REFERENCE if setting is None else setting.key
-    rec: dict[str, Any] = {"scenario": scenario.name, "key": key, "setting": None if setting is None else asdict(setting),
-                           "status": "ok", "error": ""}
+    rec: dict[str, Any] = {
+        "scenario": scenario.name,
+        "key": key,
+        "setting": None if setting is None else asdict(setting),
+        "status": "ok",
+        "error": "",
+    }
     t0 = time.perf_counter()
     try:
         mech = scenario.factory()
@@ -212,16 +229,23 @@ def accuracy_task(scenario: Scenario, setting: Setting | None, out_dir: str | Pa
         else:
             every = scenario.output_interval if scenario.output_interval > setting.timestep else None
             result = simulate(mech, duration=duration, options=setting.options(), output_interval=every)
-        stats = run_statistics(result, period=period, skip=scenario.skip_revolutions * period, blocks=scenario.blocks,
-                               ideal_output=ideal_output_function(mech, duration))
+        stats = run_statistics(
+            result,
+            period=period,
+            skip=scenario.skip_revolutions * period,
+            blocks=scenario.blocks,
+            ideal_output=ideal_output_function(mech, duration),
+        )
         rec["statistics"] = statistics_as_dict(stats)
         result.metadata["clearance"] = {j.name: j.clearance.radial_clearance for j in mech.clearance_joints}
         rec["distributions"] = distributions(result, skip=scenario.skip_revolutions * period)
         rec["first_impact"] = {j: (asdict(fi) if (fi := first_impact(result, j)) else None) for j in result.joints}
         rec["period"] = period
         rec["clearance"] = {j.name: j.clearance.radial_clearance for j in mech.clearance_joints}
-        rec["metadata"] = {k: result.metadata.get(k) for k in ("segments", "contact", "steps", "wall_time_s",
-                                                                "steps_per_second", "solver")}
+        rec["metadata"] = {
+            k: result.metadata.get(k)
+            for k in ("segments", "contact", "steps", "wall_time_s", "steps_per_second", "solver")
+        }
         head = (result.times < 2 * period) & (np.arange(len(result.times)) < _HEAD_ROWS)
         arrays = {"times": result.times[head]}
         for j, jr in result.joints.items():
@@ -231,7 +255,7 @@ def accuracy_task(scenario: Scenario, setting: Setting | None, out_dir: str | Pa
         buf = io.BytesIO()
         np.savez_compressed(buf, **arrays)
         atomic_write_bytes(_task_path(out, "accuracy", scenario.name, key).with_suffix(".npz"), buf.getvalue())
-    except Exception as err:  # noqa: BLE001 - the error a user sees is this setting's result
+    except Exception as err:
         rec["status"], rec["error"] = "error", f"{type(err).__name__}: {err}"
     rec["wall_time_s"] = time.perf_counter() - t0
     path = _task_path(out, "accuracy", scenario.name, key)
@@ -279,7 +303,7 @@ def timing_task(scenario: Scenario, setting: Setting | None, *, repeats: int = 2
         rec["cpu_per_rev_s"] = cpu / scenario.timing_revolutions
         rec["prepare_s"] = prep
         rec["load_average"] = os.getloadavg()[0]  # other work on the machine while timing
-    except Exception as err:  # noqa: BLE001 - recorded; the bench goes on
+    except Exception as err:
         rec["status"], rec["error"] = "error", f"{type(err).__name__}: {err}"
     return rec
 
@@ -339,8 +363,10 @@ def run_speed_error(
         jobs = _todo(out, "accuracy", scenarios)
         jobs.sort(key=_cost, reverse=True)  # longest first, so the pool ends together
         if jobs:
-            with (open_executor(executor, max_workers=max_workers) as pool,
-                  Progress(len(jobs), enabled=progress, desc="accuracy") as bar):
+            with (
+                open_executor(executor, max_workers=max_workers) as pool,
+                Progress(len(jobs), enabled=progress, desc="accuracy") as bar,
+            ):
                 futs = {pool.executor.submit(accuracy_task, sc, st, out): (sc, st) for sc, st in jobs}
                 for fut in as_completed(futs):
                     sc, st = futs[fut]

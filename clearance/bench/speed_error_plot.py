@@ -9,10 +9,10 @@ from pathlib import Path
 import matplotlib
 
 matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.pyplot as plt
 
-from clearance.analysis.figures.plots import save_figure  # noqa: E402
-from clearance.bench.speed_error_report import SettingRow, pareto_front  # noqa: E402
+from clearance.analysis.figures.plots import save_figure
+from clearance.bench.speed_error_report import SettingRow, pareto_front
 
 __all__ = ["plot_speed_error"]
 
@@ -21,8 +21,12 @@ _MARKERS = {"sphere-sphere": "o", "capsule-capsule": "s", "sphere-box": "^", "cy
 _PANELS = (("statistics_error", "worst statistic error", 0.05), ("first_impact_error", "first-impact error", 0.01))
 
 
-def plot_speed_error(rows: Mapping[str, Sequence[SettingRow]], *, path: str | Path | None = None,
-                     goals: tuple[float, float] = (30.0, 300.0)) -> plt.Figure:
+def plot_speed_error(
+    rows: Mapping[str, Sequence[SettingRow]],
+    *,
+    path: str | Path | None = None,
+    goals: tuple[float, float] = (30.0, 300.0),
+) -> plt.Figure:
     """Error against speed-up for every scenario (one row of two panels per scenario).
 
     Args:
@@ -43,12 +47,26 @@ def plot_speed_error(rows: Mapping[str, Sequence[SettingRow]], *, path: str | Pa
                 if not math.isfinite(y):
                     continue
                 pair = f"{r.setting['journal_geom']}-{r.setting['segment_geom']}"
-                ax.scatter(r.speedup, max(100 * y, 1e-2), color=_COLORS.get(r.setting["contact_mode"], "k"),
-                           marker=_MARKERS.get(pair, "x"), s=28, alpha=0.8, edgecolors="none")
+                ax.scatter(
+                    r.speedup,
+                    max(100 * y, 1e-2),
+                    color=_COLORS.get(r.setting["contact_mode"], "k"),
+                    marker=_MARKERS.get(pair, "x"),
+                    s=28,
+                    alpha=0.8,
+                    edgecolors="none",
+                )
             front = pareto_front(ok, attr)
             if front:
-                ax.step([r.speedup for r in front], [max(100 * getattr(r, attr), 1e-2) for r in front],
-                        where="post", color="k", lw=1, alpha=0.6, label="Pareto front")
+                ax.step(
+                    [r.speedup for r in front],
+                    [max(100 * getattr(r, attr), 1e-2) for r in front],
+                    where="post",
+                    color="k",
+                    lw=1,
+                    alpha=0.6,
+                    label="Pareto front",
+                )
             ax.axhline(100 * tol, color="tab:red", ls="--", lw=1, label=f"{100 * tol:g} % goal")
             for g in goals:
                 ax.axvline(g, color="grey", ls=":", lw=1)
@@ -59,13 +77,22 @@ def plot_speed_error(rows: Mapping[str, Sequence[SettingRow]], *, path: str | Pa
             ax.set_title(f"{name}: {title}", fontsize=10)
             ax.grid(True, which="both", alpha=0.25)
     handles = [plt.Line2D([], [], color=c, marker="o", ls="", label=m) for m, c in _COLORS.items()]
-    shown = {f"{r.setting['journal_geom']}-{r.setting['segment_geom']}" for rs in rows.values() for r in rs
-             if r.status == "ok"}  # the legend names only the geom pairs that were run
-    handles += [plt.Line2D([], [], color="grey", marker=mk, ls="", label=p.replace("-", "/"))
-                for p, mk in _MARKERS.items() if p in shown]
-    handles += [plt.Line2D([], [], color="k", lw=1, label="Pareto front"),
-                plt.Line2D([], [], color="tab:red", ls="--", label="goal"),
-                plt.Line2D([], [], color="grey", ls=":", label=" / ".join(f"{g:g}×" for g in goals))]
+    shown = {
+        f"{r.setting['journal_geom']}-{r.setting['segment_geom']}"
+        for rs in rows.values()
+        for r in rs
+        if r.status == "ok"
+    }  # the legend names only the geom pairs that were run
+    handles += [
+        plt.Line2D([], [], color="grey", marker=mk, ls="", label=p.replace("-", "/"))
+        for p, mk in _MARKERS.items()
+        if p in shown
+    ]
+    handles += [
+        plt.Line2D([], [], color="k", lw=1, label="Pareto front"),
+        plt.Line2D([], [], color="tab:red", ls="--", label="goal"),
+        plt.Line2D([], [], color="grey", ls=":", label=" / ".join(f"{g:g}×" for g in goals)),
+    ]
     fig.legend(handles=handles, loc="upper center", ncol=len(handles), fontsize=8, frameon=False)
     fig.tight_layout(rect=(0, 0, 1, 1 - 0.35 / (3.6 * len(names))))
     if path is not None:

@@ -38,8 +38,15 @@ from clearance.analysis.metrics.accuracy import (
 )
 from clearance.bench.speed_error import REFERENCE, Scenario
 
-__all__ = ["SEPARATION_FRACTION", "SettingRow", "choose_defaults", "compare_scenario", "pareto_front",
-           "reference_scatter", "speed_error_markdown"]
+__all__ = [
+    "SEPARATION_FRACTION",
+    "SettingRow",
+    "choose_defaults",
+    "compare_scenario",
+    "pareto_front",
+    "reference_scatter",
+    "speed_error_markdown",
+]
 
 SEPARATION_FRACTION = 0.1
 """Runs have separated once their journal centres are this fraction of the clearance apart."""
@@ -101,8 +108,10 @@ def _load(path: Path) -> dict[str, Any] | None:
 
 
 def _stats(rec: Mapping[str, Any]) -> dict[str, dict[str, Statistic]]:
-    return {j: {k: Statistic(s["value"], s["scatter"], s["blocks"], tuple(s.get("block_values", ())))
-                for k, s in d.items()} for j, d in rec["statistics"].items()}
+    return {
+        j: {k: Statistic(s["value"], s["scatter"], s["blocks"], tuple(s.get("block_values", ()))) for k, s in d.items()}
+        for j, d in rec["statistics"].items()
+    }
 
 
 def _first(rec: Mapping[str, Any], joint: str) -> FirstImpact | None:
@@ -127,7 +136,9 @@ def _separation(out: Path, scenario: str, key: str, ref: Mapping[str, Any]) -> d
     return sep
 
 
-def compare_scenario(scenario: Scenario, out_dir: str | Path, *, fixed_per_rev: float | None = None) -> list[SettingRow]:
+def compare_scenario(
+    scenario: Scenario, out_dir: str | Path, *, fixed_per_rev: float | None = None
+) -> list[SettingRow]:
     """Rows of every setting of ``scenario`` that has accuracy and timing files.
 
     Args:
@@ -169,12 +180,15 @@ def compare_scenario(scenario: Scenario, out_dir: str | Path, *, fixed_per_rev: 
             row.speedup_fixed = fixed_per_rev / row.cpu_per_rev
         row.first_impact = {j: first_impact_errors(_first(acc, j), _first(ref, j)) for j in ref["first_impact"]}
         # a first impact missing on either side (NaN) is the worst error, not one max() may skip
-        row.first_impact_error = max(math.inf if math.isnan(e[k]) else abs(e[k])
-                                     for e in row.first_impact.values() for k in _FIRST)
+        row.first_impact_error = max(
+            math.inf if math.isnan(e[k]) else abs(e[k]) for e in row.first_impact.values() for k in _FIRST
+        )
         row.separation = _separation(out, scenario.name, st.key, ref)
         row.statistics = statistic_errors(_stats(acc), ref_stats, clearance=ref["clearance"])
-        worst = max(((abs(v["error"]), f"{j}: {k}") for j, d in row.statistics.items() for k, v in d.items()),
-                    key=lambda x: -1.0 if math.isnan(x[0]) else x[0])
+        worst = max(
+            ((abs(v["error"]), f"{j}: {k}") for j, d in row.statistics.items() for k, v in d.items()),
+            key=lambda x: -1.0 if math.isnan(x[0]) else x[0],
+        )
         row.statistics_error, row.worst_statistic = worst
         rows.append(row)
     return rows
@@ -215,8 +229,9 @@ def pareto_front(rows: Sequence[SettingRow], error: str) -> list[SettingRow]:
     return front
 
 
-def choose_defaults(rows: Sequence[SettingRow], *, statistics_tol: float = 0.05,
-                    first_impact_tol: float = 0.01) -> dict[str, SettingRow | None]:
+def choose_defaults(
+    rows: Sequence[SettingRow], *, statistics_tol: float = 0.05, first_impact_tol: float = 0.01
+) -> dict[str, SettingRow | None]:
     """The fastest setting within each tolerance.
 
     Returns:
@@ -245,8 +260,14 @@ def _speed(x: float) -> str:
     return "–" if not math.isfinite(x) else (f"{x:.0f}×" if x >= 10 else f"{x:.1f}×")
 
 
-def speed_error_markdown(scenario: Scenario, rows: Sequence[SettingRow], *, reference_per_rev: float,
-                         fixed_per_rev: float | None = None, ref_scatter: Mapping[str, float] | None = None) -> str:
+def speed_error_markdown(
+    scenario: Scenario,
+    rows: Sequence[SettingRow],
+    *,
+    reference_per_rev: float,
+    fixed_per_rev: float | None = None,
+    ref_scatter: Mapping[str, float] | None = None,
+) -> str:
     """Markdown section of one scenario: its settings, front and chosen settings.
 
     Args:
@@ -257,20 +278,40 @@ def speed_error_markdown(scenario: Scenario, rows: Sequence[SettingRow], *, refe
         ref_scatter: statistic -> the reference's relative scatter (worst over joints).
     """
     stats = list(STATISTICS)
-    lines = [f"## {scenario.name}", "", scenario.description, "",
-             f"Reference: {reference_per_rev:.3g} s CPU time per revolution. Accuracy runs: {scenario.revolutions:g} revolutions, "
-             f"statistics over revolutions {scenario.skip_revolutions:g}–{scenario.revolutions:g} in "
-             f"{scenario.blocks} blocks; timing runs: {scenario.timing_revolutions:g} revolutions.", ""]
+    lines = [
+        f"## {scenario.name}",
+        "",
+        scenario.description,
+        "",
+        f"Reference: {reference_per_rev:.3g} s CPU time per revolution. "
+        f"Accuracy runs: {scenario.revolutions:g} revolutions, "
+        f"statistics over revolutions {scenario.skip_revolutions:g}–{scenario.revolutions:g} in "
+        f"{scenario.blocks} blocks; timing runs: {scenario.timing_revolutions:g} revolutions.",
+        "",
+    ]
     if ref_scatter:
-        lines += ["Reference scatter (relative standard error of each statistic, worst joint): "
-                  + ", ".join(f"{k} {100 * v:.1f} %" for k, v in ref_scatter.items()) + ".", ""]
-    head = ["setting", "N", "CPU/rev [ms]", "wall/rev [ms]", "× ref"] + (["× fixed"] if fixed_per_rev else []) + [
-        "first impact: F, δ, impulse [%]", "separates [ms]"] + [f"{s} [%]" for s in stats] + ["worst stat [%]"]
+        lines += [
+            "Reference scatter (relative standard error of each statistic, worst joint): "
+            + ", ".join(f"{k} {100 * v:.1f} %" for k, v in ref_scatter.items())
+            + ".",
+            "",
+        ]
+    head = (
+        ["setting", "N", "CPU/rev [ms]", "wall/rev [ms]", "× ref"]
+        + (["× fixed"] if fixed_per_rev else [])
+        + ["first impact: F, δ, impulse [%]", "separates [ms]"]
+        + [f"{s} [%]" for s in stats]
+        + ["worst stat [%]"]
+    )
     lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in sorted(rows, key=lambda r: (r.status != "ok", r.cpu_per_rev)):
         if r.status != "ok":
-            lines.append(f"| {r.label} | | | | | " + ("| " if fixed_per_rev else "")
-                         + f"{r.error_message.splitlines()[0][:160]} |" + " |" * (len(head) - 6 - bool(fixed_per_rev)))
+            lines.append(
+                f"| {r.label} | | | | | "
+                + ("| " if fixed_per_rev else "")
+                + f"{r.error_message.splitlines()[0][:160]} |"
+                + " |" * (len(head) - 6 - bool(fixed_per_rev))
+            )
             continue
         fi = "; ".join(", ".join(_pct(e[k]) for k in _FIRST) for e in r.first_impact.values())
         sep = ", ".join(f"{1e3 * v:.2f}" if v >= 0 else f"≥ {-1e3 * v:.2f}" for v in r.separation.values())
@@ -280,22 +321,39 @@ def speed_error_markdown(scenario: Scenario, rows: Sequence[SettingRow], *, refe
             e = worst.get(s)
             cells.append("–" if e is None else f"{_pct(e['error'])} ±{100 * e['scatter']:.1f}")
         segs = ", ".join(str(v) for v in r.segments.values())
-        row = [r.label, segs, f"{1e3 * r.cpu_per_rev:.2f}", f"{1e3 * r.wall_per_rev:.2f}", _speed(r.speedup)] + (
-            [_speed(r.speedup_fixed)] if fixed_per_rev else []) + [fi, sep] + cells + [f"{100 * r.statistics_error:.1f}"]
+        row = (
+            [r.label, segs, f"{1e3 * r.cpu_per_rev:.2f}", f"{1e3 * r.wall_per_rev:.2f}", _speed(r.speedup)]
+            + ([_speed(r.speedup_fixed)] if fixed_per_rev else [])
+            + [fi, sep]
+            + cells
+            + [f"{100 * r.statistics_error:.1f}"]
+        )
         lines.append("| " + " | ".join(row) + " |")
     lines.append("")
     for name, err in (("statistics", "statistics_error"), ("first impact", "first_impact_error")):
         front = pareto_front(rows, err)
-        lines.append(f"Pareto front ({name} error): " + "; ".join(
-            f"{r.label} ({_speed(r.speedup)}, {100 * getattr(r, err):.1f} %)" for r in front) + ".")
+        lines.append(
+            f"Pareto front ({name} error): "
+            + "; ".join(f"{r.label} ({_speed(r.speedup)}, {100 * getattr(r, err):.1f} %)" for r in front)
+            + "."
+        )
     d = choose_defaults(rows)
     lines += ["", "Fastest within the tolerances:", ""]
-    for k, text in (("statistics", "every statistic within 5 %"), ("first_impact", "first impact within 1 %"),
-                    ("both", "both")):
+    for k, text in (
+        ("statistics", "every statistic within 5 %"),
+        ("first_impact", "first impact within 1 %"),
+        ("both", "both"),
+    ):
         r = d[k]
-        lines.append(f"- {text}: " + ("none of the settings" if r is None else
-                                      f"{r.label}: {_speed(r.speedup)} faster than the reference"
-                                      + (f", {_speed(r.speedup_fixed)} than the fixed baseline" if fixed_per_rev else "")
-                                      + f" (statistics {100 * r.statistics_error:.1f} %, first impact "
-                                      f"{100 * r.first_impact_error:.1f} %)"))
+        lines.append(
+            f"- {text}: "
+            + (
+                "none of the settings"
+                if r is None
+                else f"{r.label}: {_speed(r.speedup)} faster than the reference"
+                + (f", {_speed(r.speedup_fixed)} than the fixed baseline" if fixed_per_rev else "")
+                + f" (statistics {100 * r.statistics_error:.1f} %, first impact "
+                f"{100 * r.first_impact_error:.1f} %)"
+            )
+        )
     return "\n".join(lines) + "\n"

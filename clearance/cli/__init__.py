@@ -24,13 +24,22 @@ from clearance.kinematics import AssemblyError
 __all__ = ["main", "build_parser"]
 
 _OWN_PARSER = {
-    "calibrate": ("clearance.cli.calibrate", "main_calibrate",
-                  "fit contact parameters to LN impacts; table and force-time plot"),
-    "sweep": ("clearance.cli.sweep", "main_sweep",
-              "bifurcation diagram over clearance or drive speed (resumable sweep)"),
+    "calibrate": (
+        "clearance.cli.calibrate",
+        "main_calibrate",
+        "fit contact parameters to LN impacts; table and force-time plot",
+    ),
+    "sweep": (
+        "clearance.cli.sweep",
+        "main_sweep",
+        "bifurcation diagram over clearance or drive speed (resumable sweep)",
+    ),
     "rank": ("clearance.cli.rank", "main_rank", "joint criticality ranking (resumable sweep)"),
-    "bench": ("clearance.cli.bench", "main_bench",
-              "speed against error of MuJoCo settings against the reference solver"),
+    "bench": (
+        "clearance.cli.bench",
+        "main_bench",
+        "speed against error of MuJoCo settings against the reference solver",
+    ),
 }
 """Commands with a parser of their own: name -> (module, entry point, help)."""
 

@@ -1,8 +1,8 @@
 """``clearance bench``: speed against error of MuJoCo settings, against the reference solver.
 
-    clearance bench                       full benchmark into clearance-bench/ (hours on 2 cores; resumable)
-    clearance bench --quick               a small grid and short runs (minutes)
-    clearance bench --stage report        only rebuild the table and figure from the files
+clearance bench                       full benchmark into clearance-bench/ (hours on 2 cores; resumable)
+clearance bench --quick               a small grid and short runs (minutes)
+clearance bench --stage report        only rebuild the table and figure from the files
 """
 
 from __future__ import annotations
@@ -23,8 +23,12 @@ def bench_parser() -> argparse.ArgumentParser:
     p.add_argument("--out", default="clearance-bench", help="output folder (default clearance-bench); rerun to resume")
     p.add_argument("--quick", action="store_true", help="small grid and short runs (minutes)")
     p.add_argument("--scenarios", nargs="*", default=None, metavar="NAME", help="scenarios to run (default all)")
-    p.add_argument("--stage", choices=("all", "accuracy", "timing", "report"), default="all",
-                   help="accuracy runs (parallel), timing runs (one at a time), report, or all (default)")
+    p.add_argument(
+        "--stage",
+        choices=("all", "accuracy", "timing", "report"),
+        default="all",
+        help="accuracy runs (parallel), timing runs (one at a time), report, or all (default)",
+    )
     p.add_argument("--workers", type=int, default=None, help="processes for the accuracy runs (default: CPU count)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     return p

@@ -23,17 +23,28 @@ def calibrate_parser() -> argparse.ArgumentParser:
     p = argparse.ArgumentParser(
         prog="clearance calibrate",
         description="Fit the MuJoCo contact of every clearance joint of a scenario to LN impacts, at the "
-                    "sizing 'clearance run' uses (effective mass: median over the ideal cycle, with its "
-                    "min-max range; fit speeds: impact speed / 50 to impact speed). The calibration file "
-                    "is what 'clearance run --contact-mode calibrated' then reuses for the same scenario "
-                    "and numerics.")
+        "sizing 'clearance run' uses (effective mass: median over the ideal cycle, with its "
+        "min-max range; fit speeds: impact speed / 50 to impact speed). The calibration file "
+        "is what 'clearance run --contact-mode calibrated' then reuses for the same scenario "
+        "and numerics.",
+    )
     add_scenario_args(p, contact_mode=False)
     g = p.add_argument_group("fit")
-    g.add_argument("--speeds", type=positive(float, "--speeds"), nargs=2, metavar=("LO", "HI"), default=None,
-                   help="fit over LO..HI [m/s] instead of the default range; such a fit is stored on its "
-                        "own and is not the one 'clearance run --contact-mode calibrated' reuses")
-    g.add_argument("--n-speeds", type=positive(int, "--n-speeds"), default=None,
-                   help="number of log-spaced speeds between LO and HI (with --speeds only; default 8)")
+    g.add_argument(
+        "--speeds",
+        type=positive(float, "--speeds"),
+        nargs=2,
+        metavar=("LO", "HI"),
+        default=None,
+        help="fit over LO..HI [m/s] instead of the default range; such a fit is stored on its "
+        "own and is not the one 'clearance run --contact-mode calibrated' reuses",
+    )
+    g.add_argument(
+        "--n-speeds",
+        type=positive(int, "--n-speeds"),
+        default=None,
+        help="number of log-spaced speeds between LO and HI (with --speeds only; default 8)",
+    )
     g.add_argument("--no-cache", action="store_true", help="refit even if a calibration file exists")
     p.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
     return p
@@ -60,8 +71,10 @@ def main_calibrate(argv: Sequence[str] | None = None) -> int:
     if args.speeds is not None and not args.speeds[0] < args.speeds[1]:
         p.error(f"--speeds: LO must be below HI (got {args.speeds[0]:g} {args.speeds[1]:g} m/s)")
     if args.n_speeds is not None and args.speeds is None:
-        p.error("--n-speeds needs --speeds LO HI (the default fit uses 8 speeds from impact speed / 50 "
-                "to impact speed, the ones a calibrated run reuses)")
+        p.error(
+            "--n-speeds needs --speeds LO HI (the default fit uses 8 speeds from impact speed / 50 "
+            "to impact speed, the ones a calibrated run reuses)"
+        )
     if args.n_speeds is not None and args.n_speeds < 2:
         p.error(f"--n-speeds must be at least 2 (got {args.n_speeds})")
     try:
@@ -73,11 +86,19 @@ def main_calibrate(argv: Sequence[str] | None = None) -> int:
         speeds = np.geomspace(args.speeds[0], args.speeds[1], args.n_speeds or 8) if args.speeds else None
         for j in mech.clearance_joints:
             ring = prep.built.rings[j.name]
-            result, path = calibrate_joint(j, ring, prep.sizing[j.name], options, speeds=speeds,
-                                           use_cache=not args.no_cache)
-            files = calibration_report(result, j.clearance, ring, options, out_dir=args.out,
-                                       stem=f"calibration_{j.name}", title=f"Contact calibration: {j.name}",
-                                       source=str(path) if path else None)
+            result, path = calibrate_joint(
+                j, ring, prep.sizing[j.name], options, speeds=speeds, use_cache=not args.no_cache
+            )
+            files = calibration_report(
+                result,
+                j.clearance,
+                ring,
+                options,
+                out_dir=args.out,
+                stem=f"calibration_{j.name}",
+                title=f"Contact calibration: {j.name}",
+                source=str(path) if path else None,
+            )
             print(files.markdown.read_text())
             print(f"wrote {files.markdown} and {files.plot}")
     except (ValueError, CalibrationStabilityError) as exc:

@@ -48,8 +48,12 @@ SEGMENT_GEOMS = ("sphere", "capsule", "box", "cylinder")
 CONTACT_MODES = ("nominal", "calibrated", "exact_ln")
 
 
-_FACTORS = {"mm": UNITS["length"]["mm"], "rpm": UNITS["angular_speed"]["rpm"], "ms": UNITS["time"]["ms"],
-            "us": UNITS["time"]["us"]}
+_FACTORS = {
+    "mm": UNITS["length"]["mm"],
+    "rpm": UNITS["angular_speed"]["rpm"],
+    "ms": UNITS["time"]["ms"],
+    "us": UNITS["time"]["us"],
+}
 
 _N = TypeVar("_N", int, float)
 
@@ -87,20 +91,40 @@ def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, cont
     g = p.add_argument_group("scenario")
     from clearance.builders import CATALOGUE
 
-    g.add_argument("--mechanism", default="slider_crank", choices=sorted(CATALOGUE), metavar="NAME",
-                   help="mechanism from the catalogue (default: slider_crank; one of: "
-                        + ", ".join(sorted(CATALOGUE)) + ")")
-    g.add_argument("--scenario", default=None, metavar="TOML",
-                   help="scenario file (a catalogue builder with overrides, or a whole mechanism); "
-                        "replaces --mechanism and the options below")
-    g.add_argument("--clearance-mm", type=positive(float, "--clearance-mm"), default=None,
-                   help="radial clearance c [mm] (default: the builder's; 0.5 for the slider-crank)")
-    g.add_argument("--clearance-at", nargs="*", default=None, metavar="JOINT",
-                   help="joints with clearance (default: the builder's, rod_slider for the slider-crank); "
-                        "give none for the ideal mechanism")
-    g.add_argument("--rpm", type=positive(float, "--rpm"), default=None,
-                   help="speed of the driven crank [rpm] (the press: crank 2; default: the builder's, "
-                        "5000 for the slider-crank)")
+    g.add_argument(
+        "--mechanism",
+        default="slider_crank",
+        choices=sorted(CATALOGUE),
+        metavar="NAME",
+        help="mechanism from the catalogue (default: slider_crank; one of: " + ", ".join(sorted(CATALOGUE)) + ")",
+    )
+    g.add_argument(
+        "--scenario",
+        default=None,
+        metavar="TOML",
+        help="scenario file (a catalogue builder with overrides, or a whole mechanism); "
+        "replaces --mechanism and the options below",
+    )
+    g.add_argument(
+        "--clearance-mm",
+        type=positive(float, "--clearance-mm"),
+        default=None,
+        help="radial clearance c [mm] (default: the builder's; 0.5 for the slider-crank)",
+    )
+    g.add_argument(
+        "--clearance-at",
+        nargs="*",
+        default=None,
+        metavar="JOINT",
+        help="joints with clearance (default: the builder's, rod_slider for the slider-crank); "
+        "give none for the ideal mechanism",
+    )
+    g.add_argument(
+        "--rpm",
+        type=positive(float, "--rpm"),
+        default=None,
+        help="speed of the driven crank [rpm] (the press: crank 2; default: the builder's, 5000 for the slider-crank)",
+    )
     g.add_argument("--gravity", action="store_true", help="gravity 9.81 m/s² along -y")
     if numerics:
         add_numerics_args(p, contact_mode=contact_mode)
@@ -113,21 +137,30 @@ def add_numerics_args(p: argparse.ArgumentParser, *, contact_mode: bool = True) 
     """Add the MuJoCo numerics group: time step, segments, geoms and (optionally) contact mode."""
     dflt = ModelOptions()
     g = p.add_argument_group("numerics")
-    g.add_argument("--timestep-us", type=positive(float, "--timestep-us"), default=dflt.timestep * 1e6,
-                   help=f"time step [µs] (default {dflt.timestep * 1e6:g}; see benchmarks/speed_error.md)")
-    g.add_argument("--segments", type=int, default=None,
-                   help="bearing segment count N (default: chosen by the ripple rule)")
-    g.add_argument("--journal-geom", default="sphere", choices=JOURNAL_GEOMS,
-                   help="journal geom (default sphere)")
-    g.add_argument("--segment-geom", default="sphere", choices=SEGMENT_GEOMS,
-                   help="bearing segment geom (default sphere)")
+    g.add_argument(
+        "--timestep-us",
+        type=positive(float, "--timestep-us"),
+        default=dflt.timestep * 1e6,
+        help=f"time step [µs] (default {dflt.timestep * 1e6:g}; see benchmarks/speed_error.md)",
+    )
+    g.add_argument(
+        "--segments", type=int, default=None, help="bearing segment count N (default: chosen by the ripple rule)"
+    )
+    g.add_argument("--journal-geom", default="sphere", choices=JOURNAL_GEOMS, help="journal geom (default sphere)")
+    g.add_argument(
+        "--segment-geom", default="sphere", choices=SEGMENT_GEOMS, help="bearing segment geom (default sphere)"
+    )
     if contact_mode:
-        g.add_argument("--contact-mode", default=dflt.contact_mode.value, choices=CONTACT_MODES,
-                       help=f"contact parameters (default {dflt.contact_mode.value}): nominal (formulas), "
-                            "calibrated (fitted to LN impacts once, then reused from the cache; see "
-                            "'clearance calibrate') or exact_ln (the LN force imposed every step: every "
-                            "statistic within 3 %% of the reference on the default scenario, about 10x "
-                            "slower; frictionless joints only)")
+        g.add_argument(
+            "--contact-mode",
+            default=dflt.contact_mode.value,
+            choices=CONTACT_MODES,
+            help=f"contact parameters (default {dflt.contact_mode.value}): nominal (formulas), "
+            "calibrated (fitted to LN impacts once, then reused from the cache; see "
+            "'clearance calibrate') or exact_ln (the LN force imposed every step: every "
+            "statistic within 3 %% of the reference on the default scenario, about 10x "
+            "slower; frictionless joints only)",
+        )
 
 
 def numerics_given(args: argparse.Namespace) -> list[str]:
@@ -145,26 +178,41 @@ def mechanism_from_args(args: argparse.Namespace) -> Mechanism:
     from clearance.builders import CATALOGUE, load_scenario
 
     if args.scenario:
-        given = [o for o, v in (("--clearance-mm", args.clearance_mm), ("--clearance-at", args.clearance_at),
-                                ("--rpm", args.rpm)) if v is not None]
+        given = [
+            o
+            for o, v in (
+                ("--clearance-mm", args.clearance_mm),
+                ("--clearance-at", args.clearance_at),
+                ("--rpm", args.rpm),
+            )
+            if v is not None
+        ]
         if args.gravity:
             given.append("--gravity")
         if given:
-            raise ValueError(f"{', '.join(given)}: give these in the scenario file {args.scenario}, not with --scenario")
+            raise ValueError(
+                f"{', '.join(given)}: give these in the scenario file {args.scenario}, not with --scenario"
+            )
         return load_scenario(args.scenario)
     entry = CATALOGUE[args.mechanism]
     builder, speed = entry.builder, entry.speed_keyword
     accepted = inspect.signature(builder).parameters
-    given = [(flag, key, value) for flag, key, value in (
-        ("--clearance-mm", "radial_clearance", None if args.clearance_mm is None else si(args.clearance_mm, "mm")),
-        ("--clearance-at", "clearance_at", None if args.clearance_at is None else tuple(args.clearance_at)),
-        ("--rpm", speed, None if args.rpm is None else si(args.rpm, "rpm")),
-        ("--gravity", "gravity", 9.81 if args.gravity else None),
-    ) if value is not None]
+    given = [
+        (flag, key, value)
+        for flag, key, value in (
+            ("--clearance-mm", "radial_clearance", None if args.clearance_mm is None else si(args.clearance_mm, "mm")),
+            ("--clearance-at", "clearance_at", None if args.clearance_at is None else tuple(args.clearance_at)),
+            ("--rpm", speed, None if args.rpm is None else si(args.rpm, "rpm")),
+            ("--gravity", "gravity", 9.81 if args.gravity else None),
+        )
+        if value is not None
+    ]
     refused = [flag for flag, key, _ in given if key not in accepted]
     if refused:
-        raise ValueError(f"mechanism '{args.mechanism}' does not take {', '.join(refused)} from the command line; "
-                         "use a scenario file (--scenario)")
+        raise ValueError(
+            f"mechanism '{args.mechanism}' does not take {', '.join(refused)} from the command line; "
+            "use a scenario file (--scenario)"
+        )
     kw = {key: value for _, key, value in given}
     return builder(**kw)
 
@@ -187,11 +235,16 @@ def options_from_args(args: argparse.Namespace) -> ModelOptions:
 def add_sweep_args(p: argparse.ArgumentParser, command: str) -> None:
     """Options every sweep command takes: mechanism, numerics, executor, output, progress."""
     p.add_argument("--mechanism", default="slider_crank", help="catalogue mechanism (default slider_crank)")
-    p.add_argument("--timestep-us", type=positive(float, "--timestep-us"), default=5.0, help="time step [µs] (default 5)")
+    p.add_argument(
+        "--timestep-us", type=positive(float, "--timestep-us"), default=5.0, help="time step [µs] (default 5)"
+    )
     p.add_argument("--segments", type=int, default=None, help="bearing segments N (default: ripple rule)")
-    p.add_argument("--out", default=None,
-                   help=f"output folder (default clearance-{command}-<mechanism>); rerun to resume")
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="Dask scheduler address (default: local processes)")
+    p.add_argument(
+        "--out", default=None, help=f"output folder (default clearance-{command}-<mechanism>); rerun to resume"
+    )
+    p.add_argument(
+        "--scheduler", default=None, metavar="ADDRESS", help="Dask scheduler address (default: local processes)"
+    )
     p.add_argument("--workers", type=int, default=None, help="local worker processes (default: CPU count)")
     p.add_argument("--stop-after", type=int, default=None, help="stop after this many points (resume later)")
     p.add_argument("--no-progress", action="store_true", help="no progress bar")

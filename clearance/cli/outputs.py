@@ -11,8 +11,9 @@ from clearance.results import SimulationResult
 __all__ = ["write_outputs", "duration_from_args"]
 
 
-def write_outputs(args: argparse.Namespace, mech: Mechanism, result: SimulationResult, ideal: SimulationResult,
-                  out: Path) -> None:
+def write_outputs(
+    args: argparse.Namespace, mech: Mechanism, result: SimulationResult, ideal: SimulationResult, out: Path
+) -> None:
     """Write arrays, summary CSV, the Markdown report with its figures (and a rerun recording).
 
     Args:
@@ -45,12 +46,16 @@ def write_outputs(args: argparse.Namespace, mech: Mechanism, result: SimulationR
     angular = mech.outputs[0].kind is OutputKind.ANGLE
     for r in rows:
         if not r.max_penetration > 0:  # penetration = |e| - c never above 0: the journal never touched
-            print(f"  {r.joint}: no contact (the journal stayed at least {-r.max_penetration * 1e6:.3g} µm "
-                  "from the bearing)")
+            print(
+                f"  {r.joint}: no contact (the journal stayed at least {-r.max_penetration * 1e6:.3g} µm "
+                "from the bearing)"
+            )
             continue
-        print(f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
-              f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
-              f"max penetration {r.max_penetration * 1e6:.3g} µm")
+        print(
+            f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
+            f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
+            f"max penetration {r.max_penetration * 1e6:.3g} µm"
+        )
     if rows:
         unit, scale = ("rad", 1.0) if angular else ("mm", 1e3)
         print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * scale:.4g} {unit}")
@@ -77,8 +82,10 @@ def duration_from_args(args: argparse.Namespace, mech: Mechanism, default_revolu
         return si(args.duration_ms, "ms")
     if mech.drive_period is None:
         if args.revolutions is not None:
-            raise ValueError(f"--revolutions {args.revolutions:g}: mechanism '{mech.name}' is driven by torques "
-                             "alone and has no drive period; give the simulated time with --duration-ms")
+            raise ValueError(
+                f"--revolutions {args.revolutions:g}: mechanism '{mech.name}' is driven by torques "
+                "alone and has no drive period; give the simulated time with --duration-ms"
+            )
         duration = default_duration(mech)
         print(f"{mech.name} is driven by torques alone: simulating {duration:g} s (set it with --duration-ms)")
         return duration

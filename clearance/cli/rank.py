@@ -25,10 +25,21 @@ __all__ = ["main_rank", "rank_parser"]
 def rank_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance rank``."""
     p = argparse.ArgumentParser(prog="clearance rank", description="Rank clearance joints by output deviation.")
-    p.add_argument("--clearances-mm", type=positive(float, "--clearances-mm"), nargs="+", default=[0.1, 0.5], help="clearances [mm]")
-    p.add_argument("--rpm", type=positive(float, "--rpm"), nargs="+", default=None,
-                   help="drive speeds [rpm] (default the catalogue's low speed and the middle of its range: "
-                   "1000 and 3000 rpm, press 30 and 60 rpm)")
+    p.add_argument(
+        "--clearances-mm",
+        type=positive(float, "--clearances-mm"),
+        nargs="+",
+        default=[0.1, 0.5],
+        help="clearances [mm]",
+    )
+    p.add_argument(
+        "--rpm",
+        type=positive(float, "--rpm"),
+        nargs="+",
+        default=None,
+        help="drive speeds [rpm] (default the catalogue's low speed and the middle of its range: "
+        "1000 and 3000 rpm, press 30 and 60 rpm)",
+    )
     p.add_argument("--joints", nargs="*", default=None, help="joints (default: all but driven/output ground pivots)")
     p.add_argument("--periods", type=int, default=6, help="drive periods per run (default 6; the first is skipped)")
     add_sweep_args(p, "rank")
@@ -56,23 +67,36 @@ def main_rank(argv: Sequence[str] | None = None) -> int:
     if args.joints is not None:
         unknown = [j for j in args.joints if j not in clearable]
         if unknown or not args.joints:
-            return usage_error(f"--joints {args.joints} must name joints of {args.mechanism} that can carry a clearance: "
-                          f"{list(clearable)}")
+            return usage_error(
+                f"--joints {args.joints} must name joints of {args.mechanism} that can carry a clearance: "
+                f"{list(clearable)}"
+            )
     lo, hi = entry.speed_range
     speeds = [lo, 0.5 * (lo + hi)] if args.rpm is None else [si(r, "rpm") for r in args.rpm]
     clearances = [si(c, "mm") for c in args.clearances_mm]
     make = ClearanceAtJoint(entry.builder, speed_key=entry.speed_keyword)
     try:
-        probe(make, {"joint": args.joints[0] if args.joints else None, "clearance": clearances[0],
-                      "speed": speeds[0]}, args.mechanism)
+        probe(
+            make,
+            {"joint": args.joints[0] if args.joints else None, "clearance": clearances[0], "speed": speeds[0]},
+            args.mechanism,
+        )
     except UsageError as err:
         return usage_error(str(err))
     out = sweep_out(args, "rank")
     try:
         ranking = run_criticality(
-            make, clearances=clearances, speeds=speeds, joints=args.joints, out_dir=out, periods=args.periods,
-            options=sweep_options(args), scheduler_address=args.scheduler, progress=not args.no_progress,
-            stop_after=args.stop_after, max_workers=args.workers,
+            make,
+            clearances=clearances,
+            speeds=speeds,
+            joints=args.joints,
+            out_dir=out,
+            periods=args.periods,
+            options=sweep_options(args),
+            scheduler_address=args.scheduler,
+            progress=not args.no_progress,
+            stop_after=args.stop_after,
+            max_workers=args.workers,
         )
     except NothingToRankError as err:
         return report_failures(len(err.failed), len(err.failed), err.failed[0][1] if err.failed else "", out)

@@ -23,13 +23,22 @@ def add_parser(sub: Any) -> None:
     """Add ``reference`` to the subcommands ``sub`` (argparse's subparsers action)."""
     f = sub.add_parser("reference", help="run a scenario with the exact-geometry reference solver (slow)")
     add_scenario_args(f, numerics=False)  # MuJoCo numerics are refused (see command)
-    f.add_argument("--revolutions", type=positive(float, "--revolutions"), default=None,
-                   help="revolutions of the slowest speed-driven crank to simulate (default 1)")
-    f.add_argument("--duration-ms", type=positive(float, "--duration-ms"), default=None,
-                   help="simulated time [ms] (overrides --revolutions)")
+    f.add_argument(
+        "--revolutions",
+        type=positive(float, "--revolutions"),
+        default=None,
+        help="revolutions of the slowest speed-driven crank to simulate (default 1)",
+    )
+    f.add_argument(
+        "--duration-ms",
+        type=positive(float, "--duration-ms"),
+        default=None,
+        help="simulated time [ms] (overrides --revolutions)",
+    )
     f.add_argument("--rtol", type=positive(float, "--rtol"), default=1e-9, help="relative tolerance (default 1e-9)")
-    f.add_argument("--output-us", type=positive(float, "--output-us"), default=10.0,
-                   help="output interval [µs] (default 10)")
+    f.add_argument(
+        "--output-us", type=positive(float, "--output-us"), default=10.0, help="output interval [µs] (default 10)"
+    )
     f.add_argument("--out", default="clearance-reference-out", help="output folder (default clearance-reference-out)")
     f.add_argument("--rerun", default=None, metavar="PATH", help="also write a rerun recording (.rrd) to PATH")
     f.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -52,8 +61,10 @@ def command(args: argparse.Namespace) -> int:
     duration = duration_from_args(args, mech, 1.0)
     out = Path(args.out)
     interval = si(args.output_us, "us")
-    print(f"{mech.name} (reference solver): clearance at {[j.name for j in mech.clearance_joints]}, "
-          f"{duration * 1e3:.3g} ms, rtol {args.rtol:g}")
+    print(
+        f"{mech.name} (reference solver): clearance at {[j.name for j in mech.clearance_joints]}, "
+        f"{duration * 1e3:.3g} ms, rtol {args.rtol:g}"
+    )
     progress = not args.no_progress
     failed = None
     try:

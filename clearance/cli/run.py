@@ -22,14 +22,26 @@ def add_parser(sub: Any) -> None:
     """Add ``run`` to the subcommands ``sub`` (argparse's subparsers action)."""
     r = sub.add_parser("run", help="simulate a scenario and write results, figures and the model")
     add_scenario_args(r)
-    r.add_argument("--revolutions", type=positive(float, "--revolutions"), default=None,
-                   help="revolutions of the slowest speed-driven crank to simulate (default 3)")
-    r.add_argument("--duration-ms", type=positive(float, "--duration-ms"), default=None,
-                   help="simulated time [ms] (overrides --revolutions)")
+    r.add_argument(
+        "--revolutions",
+        type=positive(float, "--revolutions"),
+        default=None,
+        help="revolutions of the slowest speed-driven crank to simulate (default 3)",
+    )
+    r.add_argument(
+        "--duration-ms",
+        type=positive(float, "--duration-ms"),
+        default=None,
+        help="simulated time [ms] (overrides --revolutions)",
+    )
     r.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
-    r.add_argument("--rerun", default=None, metavar="PATH",
-                   help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH")
+    r.add_argument(
+        "--rerun",
+        default=None,
+        metavar="PATH",
+        help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH",
+    )
     r.set_defaults(run_command=command)
 
 
@@ -48,8 +60,10 @@ def command(args: argparse.Namespace) -> int:
     out.mkdir(parents=True, exist_ok=True)  # only once the models are built: a refused run leaves no folder
     atomic_write_text(out / "model.xml", prepared.to_xml())
     atomic_write_text(out / "ideal_model.xml", ideal_prepared.to_xml())
-    print(f"{mech.name}: clearance at {[j.name for j in mech.clearance_joints]}, "
-          f"{duration * 1e3:.3g} ms at h = {options.timestep:g} s, segments {prepared.metadata['segments']}")
+    print(
+        f"{mech.name}: clearance at {[j.name for j in mech.clearance_joints]}, "
+        f"{duration * 1e3:.3g} ms at h = {options.timestep:g} s, segments {prepared.metadata['segments']}"
+    )
     progress = not args.no_progress
     failed = None
     try:

@@ -25,22 +25,43 @@ __all__ = ["main_sweep", "sweep_parser"]
 
 def sweep_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance sweep``."""
-    p = argparse.ArgumentParser(prog="clearance sweep", description="Bifurcation diagram over clearance or crank speed.")
+    p = argparse.ArgumentParser(
+        prog="clearance sweep", description="Bifurcation diagram over clearance or crank speed."
+    )
     p.add_argument("--parameter", choices=["clearance", "speed"], default="clearance", help="swept parameter")
-    p.add_argument("--start", type=positive(float, "--start"), default=None,
-                   help="first value [mm or rpm] (default 0.01 mm / the catalogue's low speed: 1000 rpm, press 30 rpm)")
-    p.add_argument("--stop", type=positive(float, "--stop"), default=None,
-                   help="last value [mm or rpm] (default 1 mm / the catalogue's high speed: 5000 rpm, press 90 rpm)")
+    p.add_argument(
+        "--start",
+        type=positive(float, "--start"),
+        default=None,
+        help="first value [mm or rpm] (default 0.01 mm / the catalogue's low speed: 1000 rpm, press 30 rpm)",
+    )
+    p.add_argument(
+        "--stop",
+        type=positive(float, "--stop"),
+        default=None,
+        help="last value [mm or rpm] (default 1 mm / the catalogue's high speed: 5000 rpm, press 90 rpm)",
+    )
     p.add_argument("--points", type=int, default=200, help="number of values (default 200)")
     p.add_argument("--log", action="store_true", help="logarithmic spacing")
-    p.add_argument("--clearance-mm", type=positive(float, "--clearance-mm"), default=0.5, help="clearance when sweeping speed [mm]")
-    p.add_argument("--rpm", type=positive(float, "--rpm"), default=None,
-                   help="drive speed when sweeping clearance [rpm] (default the catalogue's high speed)")
+    p.add_argument(
+        "--clearance-mm", type=positive(float, "--clearance-mm"), default=0.5, help="clearance when sweeping speed [mm]"
+    )
+    p.add_argument(
+        "--rpm",
+        type=positive(float, "--rpm"),
+        default=None,
+        help="drive speed when sweeping clearance [rpm] (default the catalogue's high speed)",
+    )
     p.add_argument("--quantity", default=None, help="sampled quantity (default <first clearance joint>.ex)")
     p.add_argument("--periods", type=int, default=60, help="drive periods per point (default 60)")
     p.add_argument("--sampled", type=int, default=40, help="last periods sampled (default 40)")
-    p.add_argument("--clearance-at", nargs="*", default=None, metavar="JOINT",
-                   help="joints with clearance (default: the builder's default)")
+    p.add_argument(
+        "--clearance-at",
+        nargs="*",
+        default=None,
+        metavar="JOINT",
+        help="joints with clearance (default: the builder's default)",
+    )
     add_sweep_args(p, "sweep")
     return p
 
@@ -87,9 +108,18 @@ def main_sweep(argv: Sequence[str] | None = None) -> int:
     out = sweep_out(args, "sweep")
     try:
         diagram = run_bifurcation(
-            values, make, out_dir=out, parameter=key, quantity=quantity, periods=args.periods,
-            sampled=args.sampled, options=sweep_options(args), scheduler_address=args.scheduler,
-            progress=not args.no_progress, stop_after=args.stop_after, max_workers=args.workers,
+            values,
+            make,
+            out_dir=out,
+            parameter=key,
+            quantity=quantity,
+            periods=args.periods,
+            sampled=args.sampled,
+            options=sweep_options(args),
+            scheduler_address=args.scheduler,
+            progress=not args.no_progress,
+            stop_after=args.stop_after,
+            max_workers=args.workers,
         )
     except ValueError as err:
         return usage_error(str(err))

@@ -56,8 +56,9 @@ def probe(make: Callable[[dict[str, Any]], Mechanism], point: dict[str, Any], me
     try:
         return make(point)
     except TypeError as err:
-        raise UsageError(f"--mechanism {mechanism}: its builder does not take the arguments of this command "
-                         f"({err})") from None
+        raise UsageError(
+            f"--mechanism {mechanism}: its builder does not take the arguments of this command ({err})"
+        ) from None
     except ValueError as err:
         raise UsageError(f"--mechanism {mechanism} at {point}: {err}") from None
 
@@ -71,8 +72,11 @@ def report_failures(failed: int, total: int, first: str, out: Path) -> int:
         first: the first failure's message.
         out: the sweep folder.
     """
-    print(f"error: {failed} of {total} points failed (first: {first}); their rows have status 'error' in "
-          f"{out / 'sweep.csv'} and {out / 'points'}", file=sys.stderr)
+    print(
+        f"error: {failed} of {total} points failed (first: {first}); their rows have status 'error' in "
+        f"{out / 'sweep.csv'} and {out / 'points'}",
+        file=sys.stderr,
+    )
     return 1
 
 

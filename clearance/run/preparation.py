@@ -123,7 +123,10 @@ def prepare(
         fmed, fmax = float(np.median(f)), float(np.max(f))
         dtyp = (max(fmed, 1e-3 * max(fmax, 1e-9)) / K) ** (2 / 3) if fmax > 0 else 1e-7
         segs[j.name] = options.segments or choose_segments(
-            c.bearing_radius, c.radial_clearance, dtyp, ripple_limit=options.ripple_limit,
+            c.bearing_radius,
+            c.radial_clearance,
+            dtyp,
+            ripple_limit=options.ripple_limit,
             flat=options.segment_geom is GeomType.BOX,
         )
         pre[j.name] = (K, fmed, fmax, dtyp)
@@ -166,9 +169,7 @@ def prepare(
 
 def initial_controls(mechanism: Mechanism) -> np.ndarray:
     """Actuator controls at t = 0: drive speed [rad/s], or torque [N m] for torque drives."""
-    return np.array(
-        [d.torque if d.kind is DriveKind.TORQUE else float(d.rate(0.0)) for d in mechanism.drives]
-    )
+    return np.array([d.torque if d.kind is DriveKind.TORQUE else float(d.rate(0.0)) for d in mechanism.drives])
 
 
 def _contact_for(joint, built: BuiltModel, sizing: JointSizing, options: ModelOptions) -> ContactParameters:
@@ -179,9 +180,7 @@ def _contact_for(joint, built: BuiltModel, sizing: JointSizing, options: ModelOp
         try:
             from clearance.contact_calibration.store import calibrated_parameters
         except ImportError:
-            raise ValueError(
-                "contact_mode 'calibrated' is not available in this version; use 'nominal'"
-            ) from None
+            raise ValueError("contact_mode 'calibrated' is not available in this version; use 'nominal'") from None
         return calibrated_parameters(joint, ring, sizing, options)
     return nominal_parameters(joint.clearance, ring, effective_mass=sizing.effective_mass)
 

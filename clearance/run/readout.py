@@ -69,7 +69,9 @@ def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -
         dv = get(f"{jname}__jvel")[:, :2] - get(f"{jname}__bvel")[:, :2]
         w = get(f"{jname}__bangvel")[:, 2]
         # e = R^T (p_j - p_b)  =>  e' = R^T (v_j - v_b) + w (e_y, -e_x)
-        erate = np.stack([c * dv[:, 0] + s * dv[:, 1] + w * e[:, 1], -s * dv[:, 0] + c * dv[:, 1] - w * e[:, 0]], axis=1)
+        erate = np.stack(
+            [c * dv[:, 0] + s * dv[:, 1] + w * e[:, 1], -s * dv[:, 0] + c * dv[:, 1] - w * e[:, 0]], axis=1
+        )
         fw = get(f"{jname}__force")[:, :2]
         force = np.stack([c * fw[:, 0] + s * fw[:, 1], -s * fw[:, 0] + c * fw[:, 1]], axis=1)
         pen = np.hypot(e[:, 0], e[:, 1]) - ring.radial_clearance

@@ -110,12 +110,18 @@ def simulate(
         names = {j.name for j in mechanism.clearance_joints}
         for k, v in dict(initial_eccentricity).items():
             if k not in names:
-                raise ValueError(f"initial_eccentricity: '{k}' is not a clearance joint (clearance joints: {sorted(names)})")
+                raise ValueError(
+                    f"initial_eccentricity: '{k}' is not a clearance joint (clearance joints: {sorted(names)})"
+                )
             if not (len(v) == 2 and all(np.isfinite(x) for x in v)):
                 raise ValueError(f"initial_eccentricity['{k}'] must be (e_x, e_y) in metres (got {v!r})")
     prepared = prepare(mechanism, options, contact=contact)
     return simulate_prepared(
-        prepared, duration=duration, output_interval=output_interval, progress=progress, chunk_steps=chunk_steps,
+        prepared,
+        duration=duration,
+        output_interval=output_interval,
+        progress=progress,
+        chunk_steps=chunk_steps,
         initial_eccentricity=initial_eccentricity,
     )
 
@@ -212,7 +218,9 @@ def _initial_qpos(prepared: PreparedModel, targets) -> np.ndarray | None:
                 f"bearing, beyond the divergence bound {lim:.3g} m; expected |e| <= c + bound = {c + lim:.4g} m"
             )
     return offset_journals(
-        model, model.key_qpos[0], targets,
+        model,
+        model.key_qpos[0],
+        targets,
         bearings={k: mech.joint(k).clearance.radial_clearance for k in targets},
         fixed_joints=[d.joint for d in mech.drives],
     )
@@ -289,8 +297,13 @@ def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
                 f"friction {j.clearance.friction}); use 'calibrated'"
             )
     contacts = [
-        ExactLNContact(model, j.clearance, prepared.built.rings[j.name], journal_geom=f"{j.name}__journal",
-                       bearing_site=f"{j.name}__bearing")
+        ExactLNContact(
+            model,
+            j.clearance,
+            prepared.built.rings[j.name],
+            journal_geom=f"{j.name}__journal",
+            bearing_site=f"{j.name}__bearing",
+        )
         for j in prepared.mechanism.clearance_joints
     ]
     data = _start(model, qpos0)
@@ -309,8 +322,7 @@ def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
 def _remedy(prepared: PreparedModel) -> str:
     h = prepared.options.timestep
     return (
-        f"use a smaller time step (now {h:g} s, try {h / 2:g} s) or more bearing segments "
-        f"(ModelOptions(segments=...))"
+        f"use a smaller time step (now {h:g} s, try {h / 2:g} s) or more bearing segments (ModelOptions(segments=...))"
     )
 
 
@@ -340,8 +352,9 @@ def _finish(parts, prepared: PreparedModel, t0: float, *, nstep_done: int, every
     return res
 
 
-def _first_bad(prepared: PreparedModel, data: mujoco.MjData, part, states: np.ndarray, sens: np.ndarray, *,
-               warnings: bool = True):
+def _first_bad(
+    prepared: PreparedModel, data: mujoco.MjData, part, states: np.ndarray, sens: np.ndarray, *, warnings: bool = True
+):
     """(row index, joint or None, reason, remedy) of a chunk's first bad row, or None.
 
     Rows from the index on are dropped. A row is bad when its journal is beyond the
@@ -362,10 +375,15 @@ def _first_bad(prepared: PreparedModel, data: mujoco.MjData, part, states: np.nd
     remedy = _remedy(prepared)
     if worst[1] is not None and worst[0] <= first_nan:
         lim = prepared.sizing[worst[1]].penetration_limit
-        return worst[0], worst[1], (
-            f"the journal penetrated {worst[2] * 1e6:.3g} um into its bearing, beyond the bound "
-            f"{lim * 1e6:.3g} um (4 x the Hertz penetration of the expected hardest impact)"
-        ), remedy
+        return (
+            worst[0],
+            worst[1],
+            (
+                f"the journal penetrated {worst[2] * 1e6:.3g} um into its bearing, beyond the bound "
+                f"{lim * 1e6:.3g} um (4 x the Hertz penetration of the expected hardest impact)"
+            ),
+            remedy,
+        )
     if first_nan < n:
         return first_nan, None, "the state became non-finite (NaN or Inf)", remedy
     fired = [mujoco.mjtWarning(i).name for i in range(mujoco.mjtWarning.mjNWARNING.value) if data.warning[i].number > 0]

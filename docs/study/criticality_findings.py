@@ -11,6 +11,8 @@ from pathlib import Path
 
 import numpy as np
 import plan
+from press_findings import FAILS, HOLDS, PARTLY, _g, _table
+
 from clearance.analysis.figures.analysis_figures import plot_criticality
 from clearance.analysis.figures.comparison_figures import (
     TrendPanel,
@@ -25,7 +27,6 @@ from clearance.analysis.metrics.comparisons import (
 )
 from clearance.analysis.sweeps.criticality import ranking_markdown
 from clearance.builders import CATALOGUE
-from press_findings import FAILS, HOLDS, PARTLY, _g, _table
 
 
 def _mechanism(name: str):
@@ -69,8 +70,15 @@ def finding_order(crit, out: Path):
             if near and rho < 0:
                 both.append(name)
         grid = f"{len(run.clearances_mm)} × {len(run.speeds_rpm)}"
-        rows.append([name, grid, " > ".join(f"{j}({dist[j]})" for j in moving) + "".join(f", {j}*" for j in off),
-                     "yes" if near else "no", f"{rho:.2f}"])
+        rows.append(
+            [
+                name,
+                grid,
+                " > ".join(f"{j}({dist[j]})" for j in moving) + "".join(f", {j}*" for j in off),
+                "yes" if near else "no",
+                f"{rho:.2f}",
+            ]
+        )
     watt_order = [s.joint for s in watt.ranking.scores]
     verdict = HOLDS if len(both) == len(multi) else PARTLY if both else FAILS
     text = f"""Clearance at one joint at a time, every candidate joint (all revolute joints but the
@@ -131,13 +139,23 @@ def finding_slider(crit, out: Path):
     pairs = (("watt_six_bar", "watt_six_bar_slider_1"), ("stephenson_i", "stephenson_i_slider"))
     for rocker, slider in pairs:
         ra, rb = crit[rocker].ranking, crit[slider].ranking
-        plot_ranking_comparison({f"{rocker} (rocker output)": ra, f"{slider} (slider output)": rb},
-                                title=f"{rocker}: output rocker replaced by a slider",
-                                path=out / f"criticality_{rocker}_vs_slider.png")
+        plot_ranking_comparison(
+            {f"{rocker} (rocker output)": ra, f"{slider} (slider output)": rb},
+            title=f"{rocker}: output rocker replaced by a slider",
+            path=out / f"criticality_{rocker}_vs_slider.png",
+        )
         ag = rank_agreement(_moving(ra), _moving(rb))
         same += ag.same_first and ag.tau >= 0.6
-        rows.append([rocker, " > ".join(_moving(ra)), slider, " > ".join(_moving(rb)), f"{ag.tau:.2f}",
-                     "yes" if ag.same_first else "no"])
+        rows.append(
+            [
+                rocker,
+                " > ".join(_moving(ra)),
+                slider,
+                " > ".join(_moving(rb)),
+                f"{ag.tau:.2f}",
+                "yes" if ag.same_first else "no",
+            ]
+        )
     verdict = HOLDS if same == len(pairs) else PARTLY if same else FAILS
     figs = "\n\n".join(f"![{r} vs slider](criticality_{r}_vs_slider.png)" for r, _ in pairs)
     text = f"""The same criticality ranking on two pairs of mechanisms that differ only in the output
@@ -167,33 +185,56 @@ def finding_deviation(crit, out: Path):
     dev = {s: [next(c for c in cells if c.speed == s and c.clearance == x) for x in cs] for s in speeds}
     rpm = lambda s: s * 30 / np.pi  # noqa: E731
     cs_mm = [x * 1e3 for x in cs]
-    series = {f"{rpm(s):.0f} rpm": (cs_mm, [c.mean_deviation * 1e3 for c in v], [2 * c.sem * 1e3 for c in v])
-              for s, v in dev.items()}
+    series = {
+        f"{rpm(s):.0f} rpm": (cs_mm, [c.mean_deviation * 1e3 for c in v], [2 * c.sem * 1e3 for c in v])
+        for s, v in dev.items()
+    }
     ratio = {f"{rpm(s):.0f} rpm": (cs_mm, [c.mean_deviation / c.clearance for c in v]) for s, v in dev.items()}
-    plot_trends([
-        TrendPanel(series, "radial clearance [mm]", "mean slider deviation [mm]", "deviation against clearance",
-                   reference={"quoted in REFERENCES.md §5": ([0.1, 0.5], [0.05, 0.4])}),
-        TrendPanel(ratio, "radial clearance [mm]", "mean deviation / clearance [-]", "relative deviation", logx=True,
-                   reference={"quoted in REFERENCES.md §5": ([0.1, 0.5], [0.5, 0.8])}),
-    ], title="slider-crank, clearance at the rod-slider joint", path=out / "slider_crank_deviation.png")
+    plot_trends(
+        [
+            TrendPanel(
+                series,
+                "radial clearance [mm]",
+                "mean slider deviation [mm]",
+                "deviation against clearance",
+                reference={"quoted in REFERENCES.md §5": ([0.1, 0.5], [0.05, 0.4])},
+            ),
+            TrendPanel(
+                ratio,
+                "radial clearance [mm]",
+                "mean deviation / clearance [-]",
+                "relative deviation",
+                logx=True,
+                reference={"quoted in REFERENCES.md §5": ([0.1, 0.5], [0.5, 0.8])},
+            ),
+        ],
+        title="slider-crank, clearance at the rod-slider joint",
+        path=out / "slider_crank_deviation.png",
+    )
     rows, fits, lin = [], [], 0
     for s, v in dev.items():
         f = linear_fit(cs, [c.mean_deviation for c in v])
         fits.append(f)
         lin += f.r2 >= 0.95
-        rows.append([f"{rpm(s):.0f}"] + [f"{c.mean_deviation * 1e6:.1f} ({c.mean_deviation / c.clearance:.2f})"
-                                         for c in v] + [f"{f.slope:.2f}", f"{f.r2:.3f}"])
+        rows.append(
+            [f"{rpm(s):.0f}"]
+            + [f"{c.mean_deviation * 1e6:.1f} ({c.mean_deviation / c.clearance:.2f})" for c in v]
+            + [f"{f.slope:.2f}", f"{f.r2:.3f}"]
+        )
     sens = [dev[speeds[-1]][i].mean_deviation / dev[speeds[0]][i].mean_deviation for i in range(len(cs))]
     grows = sum(dev[speeds[-1]][i].mean_deviation > dev[speeds[0]][i].mean_deviation for i in range(len(cs)))
     monotone = sum(trend(speeds, [dev[s][i].mean_deviation for s in speeds]).rising_steps == 1 for i in range(len(cs)))
     most_sensitive_small = int(np.argmax(sens)) == 0
     lo, hi = dev[speeds[0]], dev[speeds[-1]]
-    n_within = sum(abs(hi[i].mean_deviation - lo[i].mean_deviation) <= 2 * np.hypot(hi[i].sem, lo[i].sem)
-                   for i in range(len(cs)))
+    n_within = sum(
+        abs(hi[i].mean_deviation - lo[i].mean_deviation) <= 2 * np.hypot(hi[i].sem, lo[i].sem) for i in range(len(cs))
+    )
     watt = crit["watt_six_bar"].ranking.cells
     wspeed = []
     for s in sorted({c.speed for c in watt}):
-        wspeed.append(f"{rpm(s):.0f} rpm: {np.mean([c.mean_deviation / c.clearance for c in watt if c.speed == s]):.1f} rad/m")
+        wspeed.append(
+            f"{rpm(s):.0f} rpm: {np.mean([c.mean_deviation / c.clearance for c in watt if c.speed == s]):.1f} rad/m"
+        )
     parts = [grows == len(cs), most_sensitive_small, lin == len(speeds)]
     verdict = HOLDS if all(parts) else PARTLY if any(parts) else FAILS
     text = f"""The slider-crank (REFERENCES.md §3 dimensions; its masses and inertias are recalled
@@ -206,7 +247,9 @@ values) with clearance at the rod-slider joint alone, clearances {", ".join(f"{c
 Mean deviation [µm] (and deviation / clearance) per speed, with a straight-line fit:
 
 {_table(["speed [rpm]"] + [f"c = {c:g} mm" for c in cs_mm] + ["slope [-]", "R²"], rows)}
-Speed: the deviation is larger at {rpm(speeds[-1]):.0f} than at {rpm(speeds[0]):.0f} rpm at {grows} of {len(cs)} clearances
+Speed: the deviation is larger at {rpm(speeds[-1]):.0f} than at {rpm(speeds[0]):.0f} rpm at {grows} of {
+        len(cs)
+    } clearances
 (rising at every speed step at {monotone} of {len(cs)}); the ratio of the
 deviation at {rpm(speeds[-1]):.0f} rpm to that at {rpm(speeds[0]):.0f} rpm is
 {", ".join(f"{r:.2f} at {c:g} mm" for r, c in zip(sens, cs_mm))}, largest at
@@ -226,15 +269,23 @@ the clearance (R² ≥ 0.95) at every speed; "partly" if some of the three hold.
 Why, and what differs: the mean deviation of the slider is mostly geometric. The journal
 rides on the loaded side of its bearing, which shifts the slider by about the clearance
 times the transmission from the joint to the slider; so the deviation is close to c at
-small clearances ({dev[speeds[0]][0].mean_deviation / cs[0]:.2f}–{dev[speeds[-1]][0].mean_deviation / cs[0]:.2f} c at {cs_mm[0]:g} mm) and grows almost linearly. Speed changes the
+small clearances ({dev[speeds[0]][0].mean_deviation / cs[0]:.2f}–{dev[speeds[-1]][0].mean_deviation / cs[0]:.2f} c at {
+        cs_mm[0]:g} mm) and grows almost linearly. Speed changes the
 load pattern and adds impacts; between {rpm(speeds[0]):.0f} and {rpm(speeds[-1]):.0f} rpm the deviation changes by
-{min(sens) - 1:+.0%} to {max(sens) - 1:+.0%} depending on the clearance ({n_within} of {len(cs)} of these changes lie within two
+{min(sens) - 1:+.0%} to {max(sens) - 1:+.0%} depending on the clearance ({n_within} of {
+        len(cs)
+    } of these changes lie within two
 standard errors of the per-period scatter): the speed effect is small next to the
-clearance's{", and not consistently upward in our slider-crank" if grows < len(cs) else ""}{"" if most_sensitive_small else
-", and it is not largest at the smallest clearance"}.
-The relative deviation falls with the clearance here ({dev[speeds[0]][cs.index(1e-4)].mean_deviation / 1e-4:.2f} c at 0.1 mm,
-{dev[speeds[0]][cs.index(5e-4)].mean_deviation / 5e-4:.2f} c at 0.5 mm at {rpm(speeds[0]):.0f} rpm) where the quoted source values rise (0.5 c to 0.8 c). In kind the
-clearance part of the finding holds{"" if parts[0] and parts[1] else " and the speed part only partly"}; in detail our slider-crank
+clearance's{", and not consistently upward in our slider-crank" if grows < len(cs) else ""}{
+        "" if most_sensitive_small else ", and it is not largest at the smallest clearance"
+    }.
+The relative deviation falls with the clearance here ({
+        dev[speeds[0]][cs.index(1e-4)].mean_deviation / 1e-4:.2f} c at 0.1 mm,
+{dev[speeds[0]][cs.index(5e-4)].mean_deviation / 5e-4:.2f} c at 0.5 mm at {
+        rpm(speeds[0]):.0f} rpm) where the quoted source values rise (0.5 c to 0.8 c). In kind the
+clearance part of the finding holds{
+        "" if parts[0] and parts[1] else " and the speed part only partly"
+    }; in detail our slider-crank
 (different link lengths and masses) does not reproduce those ratios.
 """
     return "Deviation grows with speed and almost linearly with clearance", verdict, text

@@ -56,8 +56,10 @@ def main() -> None:
     diagrams = _timed(stages, "press bifurcation diagrams", plan.run_press_bifurcations, cache, args.workers)
     crit = _timed(stages, "criticality sweeps", plan.run_criticalities, cache, args.workers)
     if any(isinstance(v, list) and len(v) > n_before.get(n, 0) for n, v in stages.items()):  # this call computed
-        stages["_machine"] = (f"{platform.machine()}, {os.cpu_count()} cores, {args.workers} workers; load average "
-                              f"{load[0]:.1f} when the computation started")
+        stages["_machine"] = (
+            f"{platform.machine()}, {os.cpu_count()} cores, {args.workers} workers; load average "
+            f"{load[0]:.1f} when the computation started"
+        )
     log.write_text(json.dumps(stages, indent=1))
     machine = stages.pop("_machine", f"{platform.machine()}, {os.cpu_count()} cores")
     t0 = time.perf_counter()

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
 from clearance.analysis.sweeps.bifurcation import BifurcationDiagram, run_bifurcation
 from clearance.analysis.sweeps.criticality import (
     ClearanceAtJoint,
@@ -20,7 +21,6 @@ from clearance.analysis.sweeps.criticality import (
 from clearance.analysis.sweeps.run_store import RunSpec, RunStore, run_batch
 from clearance.analysis.sweeps.sweep import KeywordFactory
 from clearance.builders import CATALOGUE, rpm, seven_bar_press
-
 from clearance.options import ContactMode, ModelOptions
 
 CONTACT = ContactMode.CALIBRATED  # contact fitted to LN impacts per joint (the package default)
@@ -76,8 +76,14 @@ def _press(at: tuple[str, ...], c_mm: float | None, speed: float, step: float, p
     point = {"clearance_at": at, "crank2_speed": speed * math.pi}
     if c_mm is not None:
         point["radial_clearance"] = c_mm * 1e-3
-    return RunSpec(press_name(at, c_mm, speed, step), KeywordFactory(seven_bar_press), point, periods * 2 / speed,
-                   options(step), keep_every=max(1, round(KEEP_INTERVAL / step)))
+    return RunSpec(
+        press_name(at, c_mm, speed, step),
+        KeywordFactory(seven_bar_press),
+        point,
+        periods * 2 / speed,
+        options(step),
+        keep_every=max(1, round(KEEP_INTERVAL / step)),
+    )
 
 
 def press_runs() -> list[RunSpec]:
@@ -106,14 +112,26 @@ def run_press_bifurcations(cache: Path, workers: int) -> dict[str, BifurcationDi
     over_c = KeywordFactory(seven_bar_press, fixed={"crank2_speed": SERIES_SPEED * math.pi})
     values_c = [c * 1e-3 for c in BIF_CLEARANCES_MM]
     out = {
-        "clearance": run_bifurcation(values_c, over_c, out_dir=cache / "bif_clearance",
-                                     options=options(PRESS_LONG_STEP), **common),
-        "clearance_check": run_bifurcation(values_c[::BIF_CHECK_EVERY], over_c, out_dir=cache / "bif_clearance_check",
-                                           options=options(PRESS_LONG_CHECK_STEP), **common),
+        "clearance": run_bifurcation(
+            values_c, over_c, out_dir=cache / "bif_clearance", options=options(PRESS_LONG_STEP), **common
+        ),
+        "clearance_check": run_bifurcation(
+            values_c[::BIF_CHECK_EVERY],
+            over_c,
+            out_dir=cache / "bif_clearance_check",
+            options=options(PRESS_LONG_CHECK_STEP),
+            **common,
+        ),
     }
     over_w = KeywordFactory(seven_bar_press, fixed={"radial_clearance": BIF_SPEED_CLEARANCE_MM * 1e-3})
-    out["speed"] = run_bifurcation([w * math.pi for w in BIF_SPEEDS], over_w, out_dir=cache / "bif_speed",
-                                   parameter="crank2_speed", options=options(PRESS_LONG_STEP), **common)
+    out["speed"] = run_bifurcation(
+        [w * math.pi for w in BIF_SPEEDS],
+        over_w,
+        out_dir=cache / "bif_speed",
+        parameter="crank2_speed",
+        options=options(PRESS_LONG_STEP),
+        **common,
+    )
     return out
 
 
@@ -131,9 +149,14 @@ class CriticalityRun:
 def _criticality(cache: Path, name: str, grid, workers: int, joints=None) -> CriticalityRun:
     clearances, speeds = grid
     ranking = run_criticality(
-        ClearanceAtJoint(CATALOGUE[name].builder), clearances=[c * 1e-3 for c in clearances],
-        speeds=[rpm(s) for s in speeds], joints=joints, out_dir=cache / f"crit_{name}", periods=CRIT_PERIODS,
-        options=options(CRIT_STEP), max_workers=workers,
+        ClearanceAtJoint(CATALOGUE[name].builder),
+        clearances=[c * 1e-3 for c in clearances],
+        speeds=[rpm(s) for s in speeds],
+        joints=joints,
+        out_dir=cache / f"crit_{name}",
+        periods=CRIT_PERIODS,
+        options=options(CRIT_STEP),
+        max_workers=workers,
     )
     return CriticalityRun(name, ranking, tuple(clearances), tuple(speeds), tuple(s.joint for s in ranking.scores))
 

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import plan
+
 from clearance.analysis.chaos.poincare import run_section
 from clearance.analysis.figures.analysis_figures import plot_bifurcation
 from clearance.analysis.figures.comparison_figures import (
@@ -84,6 +85,7 @@ class Press:
 
 # -- section 4: the seven-bar press ------------------------------------------------------------
 
+
 def finding_lag(press: Press, out: Path):
     w = plan.SERIES_SPEED
     T = _period(w)
@@ -96,25 +98,45 @@ def finding_lag(press: Press, out: Path):
         z = velocity_zigzag(r, ideal, OUTPUT, skip=T)
         lags.append(cmp.lag)
         zz.append(z)
-        rows.append([_g(c), f"{cmp.lag * 1e3:.3f}", f"{math.degrees(cmp.lag_angle):.3f}",
-                     f"{st.mean_signed_deviation * 1e6:.1f}", f"{z:.2f}", f"{press.flight('A', ('A',), c, w):.3f}"])
+        rows.append(
+            [
+                _g(c),
+                f"{cmp.lag * 1e3:.3f}",
+                f"{math.degrees(cmp.lag_angle):.3f}",
+                f"{st.mean_signed_deviation * 1e6:.1f}",
+                f"{z:.2f}",
+                f"{press.flight('A', ('A',), c, w):.3f}",
+            ]
+        )
     window = (2 * T, 3 * T)
-    plot_output_overlay({"ideal": ideal, "clearance at A, 0.09 mm": press.result(("A",), 0.09, w),
-                         "clearance at A, 0.8 mm": press.result(("A",), 0.8, w)}, OUTPUT, window=window,
-                        relative=True, title=f"press, crank 2 at {w:g}π rad/s: slider over the third drive period",
-                        path=out / "press_response.png")
+    plot_output_overlay(
+        {
+            "ideal": ideal,
+            "clearance at A, 0.09 mm": press.result(("A",), 0.09, w),
+            "clearance at A, 0.8 mm": press.result(("A",), 0.8, w),
+        },
+        OUTPUT,
+        window=window,
+        relative=True,
+        title=f"press, crank 2 at {w:g}π rad/s: slider over the third drive period",
+        path=out / "press_response.png",
+    )
     lagging = sum(v > 0 for v in lags)
     zig = sum(v > 1.2 for v in zz)
     cf = {c: press.flight("A", ("A",), c, w) for c in plan.SERIES_CLEARANCES_MM}
     big = [c for c, z in zip(plan.SERIES_CLEARANCES_MM, zz) if z > 1.2]
     max_lag = max(abs(v) for v in lags)
     fl = max([cf[c] for c in big], default=0.0)
-    flight_text = (f"it leaves the wall for up to {fl:.0%} of the time and bounces on it" if fl >= 0.01 else
-                   "it chatters on the wall (no flight longer than the 0.1 ms row spacing)")
+    flight_text = (
+        f"it leaves the wall for up to {fl:.0%} of the time and bounces on it"
+        if fl >= 0.01
+        else "it chatters on the wall (no flight longer than the 0.1 ms row spacing)"
+    )
     # partly: either half of the finding (lag, zig-zag) holds at half the clearances or more
     half = (len(lags) + 1) // 2
-    verdict = (HOLDS if lagging == len(lags) and zig >= len(zz) - 1
-               else PARTLY if lagging >= half or zig >= half else FAILS)
+    verdict = (
+        HOLDS if lagging == len(lags) and zig >= len(zz) - 1 else PARTLY if lagging >= half or zig >= half else FAILS
+    )
     text = f"""We ran the press with clearance at A alone, crank 2 (and the servo crank 7) at
 {w:g}π rad/s, for {plan.PRESS_PERIODS} periods ({plan.PRESS_PERIODS * T:.2f} s), and compared the slider
 with the ideal twin over the last {plan.PRESS_PERIODS - 1} periods: the lag is the time shift
@@ -125,8 +147,19 @@ the journal is off its bearing wall after the first period (stored rows, every 0
 
 ![press response](press_response.png)
 
-{_table(["clearance at A [mm]", "lag [ms]", "lag [deg of crank 2]", "offset [µm]", "velocity zig-zag [-]",
-         "time in flight at A"], rows)}
+{
+        _table(
+            [
+                "clearance at A [mm]",
+                "lag [ms]",
+                "lag [deg of crank 2]",
+                "offset [µm]",
+                "velocity zig-zag [-]",
+                "time in flight at A",
+            ],
+            rows,
+        )
+    }
 Criterion: the displacement lags (lag > 0) at every clearance and the velocity zig-zags
 (ratio > 1.2) at all clearances but at most one; partly if either holds at half the
 clearances or more. The slider lags at {lagging} of {len(lags)} clearances and zig-zags at
@@ -135,9 +168,13 @@ clearances or more. The slider lags at {lagging} of {len(lags)} clearances and z
 Why: gravity and the slider load press each journal against one side of its bearing for
 most of the cycle, so the clearance shows as an offset of the slider of about one
 clearance (the linkage hangs lower by c), not as a time lag: the best time shift is at
-most {max_lag * 1e3:.2f} ms ({math.degrees(max_lag * w * math.pi):.3f}° of crank angle){" and of the opposite sign" if lagging == 0 else ""}.
+most {max_lag * 1e3:.2f} ms ({math.degrees(max_lag * w * math.pi):.3f}° of crank angle){
+        " and of the opposite sign" if lagging == 0 else ""
+    }.
 The velocity zig-zags only at the largest clearances ({", ".join(f"{c:g}" for c in big) or "none"} mm; ratio
-{", ".join(f"{z:.2f}" for c, z in zip(plan.SERIES_CLEARANCES_MM, zz) if c in big) or "-"}), where the journal's sliding along its wall is no longer smooth:
+{
+        ", ".join(f"{z:.2f}" for c, z in zip(plan.SERIES_CLEARANCES_MM, zz) if c in big) or "-"
+    }), where the journal's sliding along its wall is no longer smooth:
 {flight_text}, and the slider velocity oscillates about the ideal curve (figure, 0.8 mm).
 """
     return "Lag of the displacement and zig-zag of the velocity", verdict, text
@@ -153,18 +190,39 @@ def finding_peaks(press: Press, out: Path):
     p95 = [press.force("A", ("A",), c, w, which="steady_p95_force") for c in cs]
     ideal = press.acc_peak((), None, w)
     h, h5 = f"{plan.PRESS_STEP * 1e6:g} µs", f"{plan.PRESS_CHECK_STEP * 1e6:g} µs"
-    plot_trends([
-        TrendPanel({f"clearance at A ({h})": (cs, acc), f"clearance at A ({h5})": (cs, acc5),
-                    "ideal": (cs, [ideal] * len(cs))}, "radial clearance at A [mm]",
-                   "peak |slider acceleration| [m/s²]", "slider acceleration peak", logx=True, logy=True),
-        TrendPanel({f"peak ({h})": (cs, force), f"peak ({h5})": (cs, force5), f"95th percentile ({h})": (cs, p95)},
-                   "radial clearance at A [mm]", "contact force at A [N]", "collision force", logx=True, logy=True),
-    ], title=f"press, crank 2 at {w:g}π rad/s: peaks after the first period", path=out / "press_peaks.png")
+    plot_trends(
+        [
+            TrendPanel(
+                {
+                    f"clearance at A ({h})": (cs, acc),
+                    f"clearance at A ({h5})": (cs, acc5),
+                    "ideal": (cs, [ideal] * len(cs)),
+                },
+                "radial clearance at A [mm]",
+                "peak |slider acceleration| [m/s²]",
+                "slider acceleration peak",
+                logx=True,
+                logy=True,
+            ),
+            TrendPanel(
+                {f"peak ({h})": (cs, force), f"peak ({h5})": (cs, force5), f"95th percentile ({h})": (cs, p95)},
+                "radial clearance at A [mm]",
+                "contact force at A [N]",
+                "collision force",
+                logx=True,
+                logy=True,
+            ),
+        ],
+        title=f"press, crank 2 at {w:g}π rad/s: peaks after the first period",
+        path=out / "press_peaks.png",
+    )
     rho = {k: trend(cs, v).spearman for k, v in (("acc", acc), ("acc5", acc5), ("f", force), ("f5", force5))}
     i3, i9, i2 = cs.index(0.03), cs.index(0.09), cs.index(0.2)
     flat = max(max(v[: i2 + 1]) / v[0] for v in (acc, acc5, force, force5)) - 1
     iw = int(np.argmax([max(a, b) / min(a, b) for a, b in zip(acc, acc5)]))  # where the steps differ most
-    rows = [[_g(c), _g(a), _g(a5), _g(f), _g(f5), _g(q)] for c, a, a5, f, f5, q in zip(cs, acc, acc5, force, force5, p95)]
+    rows = [
+        [_g(c), _g(a), _g(a5), _g(f), _g(f5), _g(q)] for c, a, a5, f, f5, q in zip(cs, acc, acc5, force, force5, p95)
+    ]
     ok = min(rho.values()) >= 0.8
     verdict = HOLDS if ok else PARTLY if max(rho.values()) > 0.5 else FAILS
     text = f"""Clearance at A alone, radial clearance {", ".join(_g(c) for c in cs)} mm, crank 2 at
@@ -174,8 +232,19 @@ was run at {h} and again at {h5} to check the step.
 
 ![press peaks](press_peaks.png)
 
-{_table(["c at A [mm]", f"acc. peak [m/s²] ({h})", f"acc. peak ({h5})", f"force peak at A [N] ({h})",
-         f"force peak ({h5})", f"95th pct. force [N] ({h})"], rows)}
+{
+        _table(
+            [
+                "c at A [mm]",
+                f"acc. peak [m/s²] ({h})",
+                f"acc. peak ({h5})",
+                f"force peak at A [N] ({h})",
+                f"force peak ({h5})",
+                f"95th pct. force [N] ({h})",
+            ],
+            rows,
+        )
+    }
 Ideal slider acceleration peak: {_g(ideal)} m/s². From 0.03 to 0.09 mm the acceleration peak
 goes {_g(acc[i3])} → {_g(acc[i9])} m/s² (×{acc[i9] / acc[i3]:.2f}) and the force peak {_g(force[i3])} →
 {_g(force[i9])} N (×{force[i9] / force[i3]:.2f}); the seed paper's values quoted in REFERENCES.md §4
@@ -199,44 +268,88 @@ seed paper.
 def finding_two_clearances(press: Press, out: Path):
     w = plan.SERIES_SPEED
     cs = plan.PAIR_CLEARANCES_MM
-    acc = {lab: [press.acc_peak(at, c, w) for c in cs] for lab, at in
-           (("A only", ("A",)), ("C only", ("C",)), ("A and C", ("A", "C")))}
+    acc = {
+        lab: [press.acc_peak(at, c, w) for c in cs]
+        for lab, at in (("A only", ("A",)), ("C only", ("C",)), ("A and C", ("A", "C")))
+    }
     ideal = press.acc_peak((), None, w)
-    fa = {"A (A only)": [press.force("A", ("A",), c, w) for c in cs],
-          "A (A and C)": [press.force("A", ("A", "C"), c, w) for c in cs],
-          "C (C only)": [press.force("C", ("C",), c, w) for c in cs],
-          "C (A and C)": [press.force("C", ("A", "C"), c, w) for c in cs]}
-    plot_trends([
-        TrendPanel({**{k: (cs, v) for k, v in acc.items()}, "ideal": (cs, [ideal] * len(cs))},
-                   "radial clearance [mm]", "peak |slider acceleration| [m/s²]", "one clearance or two", logx=True,
-                   logy=True),
-        TrendPanel({k: (cs, v) for k, v in fa.items()}, "radial clearance [mm]", "peak contact force [N]",
-                   "contact-force peaks per joint", logx=True, logy=True),
-    ], title=f"press, crank 2 at {w:g}π rad/s: clearance at A, at C, at both", path=out / "press_two_clearances.png")
+    fa = {
+        "A (A only)": [press.force("A", ("A",), c, w) for c in cs],
+        "A (A and C)": [press.force("A", ("A", "C"), c, w) for c in cs],
+        "C (C only)": [press.force("C", ("C",), c, w) for c in cs],
+        "C (A and C)": [press.force("C", ("A", "C"), c, w) for c in cs],
+    }
+    plot_trends(
+        [
+            TrendPanel(
+                {**{k: (cs, v) for k, v in acc.items()}, "ideal": (cs, [ideal] * len(cs))},
+                "radial clearance [mm]",
+                "peak |slider acceleration| [m/s²]",
+                "one clearance or two",
+                logx=True,
+                logy=True,
+            ),
+            TrendPanel(
+                {k: (cs, v) for k, v in fa.items()},
+                "radial clearance [mm]",
+                "peak contact force [N]",
+                "contact-force peaks per joint",
+                logx=True,
+                logy=True,
+            ),
+        ],
+        title=f"press, crank 2 at {w:g}π rad/s: clearance at A, at C, at both",
+        path=out / "press_two_clearances.png",
+    )
     T = _period(w)
-    plot_output_overlay({"ideal": press.result((), None, w), "A only": press.result(("A",), 0.09, w),
-                         "C only": press.result(("C",), 0.09, w), "A and C": press.result(("A", "C"), 0.09, w)},
-                        OUTPUT, window=(2 * T, 3 * T), relative=True,
-                        title="press, c = 0.09 mm: one clearance or two (third period)",
-                        path=out / "press_two_clearances_response.png")
+    plot_output_overlay(
+        {
+            "ideal": press.result((), None, w),
+            "A only": press.result(("A",), 0.09, w),
+            "C only": press.result(("C",), 0.09, w),
+            "A and C": press.result(("A", "C"), 0.09, w),
+        },
+        OUTPUT,
+        window=(2 * T, 3 * T),
+        relative=True,
+        title="press, c = 0.09 mm: one clearance or two (third period)",
+        path=out / "press_two_clearances_response.png",
+    )
     ideal_run = press.result((), None, w)
     sets = (("A only", ("A",)), ("C only", ("C",)), ("A and C", ("A", "C")))
     rms, dev = {}, {}
     for lab, at in sets:
-        st = [(deviation_statistics(press.result(at, c, w), ideal_run, f"{OUTPUT}_acc", skip=T),
-               deviation_statistics(press.result(at, c, w), ideal_run, OUTPUT, skip=T)) for c in cs]
+        st = [
+            (
+                deviation_statistics(press.result(at, c, w), ideal_run, f"{OUTPUT}_acc", skip=T),
+                deviation_statistics(press.result(at, c, w), ideal_run, OUTPUT, skip=T),
+            )
+            for c in cs
+        ]
         rms[lab] = [a.rms_deviation for a, _ in st]
         dev[lab] = [y.mean_deviation for _, y in st]
-    rows = [[_g(c)] + [_g(acc[k][i]) for k, _ in sets] + [_g(rms[k][i]) for k, _ in sets]
-            + [f"{dev[k][i] * 1e6:.0f}" for k, _ in sets] for i, c in enumerate(cs)]
+    rows = [
+        [_g(c)]
+        + [_g(acc[k][i]) for k, _ in sets]
+        + [_g(rms[k][i]) for k, _ in sets]
+        + [f"{dev[k][i] * 1e6:.0f}" for k, _ in sets]
+        for i, c in enumerate(cs)
+    ]
     wins = sum(acc["A and C"][i] > max(acc["A only"][i], acc["C only"][i]) for i in range(len(cs)))
     wins_rms = sum(rms["A and C"][i] > max(rms["A only"][i], rms["C only"][i]) for i in range(len(cs)))
     wins_dev = sum(dev["A and C"][i] > max(dev["A only"][i], dev["C only"][i]) for i in range(len(cs)))
     verdict = HOLDS if wins == len(cs) else PARTLY if wins or wins_rms else FAILS
-    misses = [(c, acc["A and C"][i] / max(acc["A only"][i], acc["C only"][i])) for i, c in enumerate(cs)
-              if acc["A and C"][i] <= max(acc["A only"][i], acc["C only"][i])]
-    miss_text = ("" if not misses else ": two clearances miss the largest peak at " + ", ".join(
-        f"{c:g} mm (×{r:.2f} of the larger single one)" for c, r in misses))
+    misses = [
+        (c, acc["A and C"][i] / max(acc["A only"][i], acc["C only"][i]))
+        for i, c in enumerate(cs)
+        if acc["A and C"][i] <= max(acc["A only"][i], acc["C only"][i])
+    ]
+    miss_text = (
+        ""
+        if not misses
+        else ": two clearances miss the largest peak at "
+        + ", ".join(f"{c:g} mm (×{r:.2f} of the larger single one)" for c, r in misses)
+    )
     text = f"""Clearance at A only, at C only, and at both, each at {", ".join(_g(c) for c in cs)} mm
 (the same clearance at both joints), crank 2 at {w:g}π rad/s, {plan.PRESS_PERIODS} periods, after the
 first period: the slider acceleration peak (every step), the RMS of the acceleration's
@@ -247,15 +360,32 @@ impact) and the mean displacement deviation.
 
 ![two clearances, response](press_two_clearances_response.png)
 
-{_table(["c [mm]", "acc. peak A [m/s²]", "peak C", "peak A+C", "RMS acc. dev. A [m/s²]", "RMS C", "RMS A+C",
-         "mean displ. dev. A [µm]", "dev. C", "dev. A+C"], rows)}
+{
+        _table(
+            [
+                "c [mm]",
+                "acc. peak A [m/s²]",
+                "peak C",
+                "peak A+C",
+                "RMS acc. dev. A [m/s²]",
+                "RMS C",
+                "RMS A+C",
+                "mean displ. dev. A [µm]",
+                "dev. C",
+                "dev. A+C",
+            ],
+            rows,
+        )
+    }
 Ideal peak {_g(ideal)} m/s². The seed paper (REFERENCES.md §4) reports 94.8 m/s² with one
 clearance and 310.8 m/s² with two (×3.3; ideal 3.59 m/s²). Criterion: two clearances give a
 larger acceleration peak than either single one at every clearance. Two clearances give
 the largest peak at {wins} of {len(cs)} clearances, the largest RMS acceleration deviation at
 {wins_rms} of {len(cs)}, and the largest displacement deviation at {wins_dev} of {len(cs)}.
 
-Why {"it holds" if verdict == HOLDS else "only partly"}: the two journals' offsets add up (the displacement deviation with both
+Why {
+        "it holds" if verdict == HOLDS else "only partly"
+    }: the two journals' offsets add up (the displacement deviation with both
 is close to the sum of the single ones) and so does the vibration (RMS), but the largest
 acceleration peak of a few periods of non-periodic motion is a single impact, and which
 configuration sees the hardest one varies{miss_text}.
@@ -272,22 +402,53 @@ def finding_speed(press: Press, diagrams, out: Path):
         peaks[key] = [press.force("A", at, cc, w) for w in ws]
         p95[key] = [press.force("A", at, cc, w, which="steady_p95_force") for w in ws]
         for w, pk, p in zip(ws, peaks[key], p95[key]):
-            rows.append([lab, _g(cc), f"{w:g}π", _g(pk), _g(p), _g(press.acc_peak(at, cc, w)),
-                         f"{press.flight('A', at, cc, w):.3f}"])
-    plot_trends([TrendPanel({f"peak, {k}": (ws, v) for k, v in peaks.items()},
-                            "crank 2 speed [π rad/s]", "peak contact force at A [N]", "peak", logy=True),
-                 TrendPanel({f"95th pct., {k}": (ws, v) for k, v in p95.items()},
-                            "crank 2 speed [π rad/s]", "95th percentile of contact force at A [N]", "95th percentile")],
-                title="press: contact force at A against drive speed (after the first period)",
-                path=out / "press_speed_forces.png")
+            rows.append(
+                [
+                    lab,
+                    _g(cc),
+                    f"{w:g}π",
+                    _g(pk),
+                    _g(p),
+                    _g(press.acc_peak(at, cc, w)),
+                    f"{press.flight('A', at, cc, w):.3f}",
+                ]
+            )
+    plot_trends(
+        [
+            TrendPanel(
+                {f"peak, {k}": (ws, v) for k, v in peaks.items()},
+                "crank 2 speed [π rad/s]",
+                "peak contact force at A [N]",
+                "peak",
+                logy=True,
+            ),
+            TrendPanel(
+                {f"95th pct., {k}": (ws, v) for k, v in p95.items()},
+                "crank 2 speed [π rad/s]",
+                "95th percentile of contact force at A [N]",
+                "95th percentile",
+            ),
+        ],
+        title="press: contact force at A against drive speed (after the first period)",
+        path=out / "press_speed_forces.png",
+    )
     panels = []
     for w in ws:
         r = press.result(("A", "C"), co, w)
-        panels.append(OrbitPanel(r.sliced(r.times >= _period(w)), "A", co * 1e-3,
-                                 f"crank 2 at {w:g}π rad/s (in flight {press.flight('A', ('A', 'C'), co, w):.0%})",
-                                 period=_period(w)))
-    plot_orbit_phase_panels(panels, title=f"press, clearance {co:g} mm at A and C: where the journal at A sits, "
-                            f"periods 2 to {plan.PRESS_PERIODS}", path=out / "press_speed_orbits.png")
+        panels.append(
+            OrbitPanel(
+                r.sliced(r.times >= _period(w)),
+                "A",
+                co * 1e-3,
+                f"crank 2 at {w:g}π rad/s (in flight {press.flight('A', ('A', 'C'), co, w):.0%})",
+                period=_period(w),
+            )
+        )
+    plot_orbit_phase_panels(
+        panels,
+        title=f"press, clearance {co:g} mm at A and C: where the journal at A sits, periods 2 to {plan.PRESS_PERIODS}",
+        path=out / "press_speed_orbits.png",
+    )
     d = diagrams["speed"]
     n3 = max(1, len(d.values) // 3)
     low = [r for r in d.regimes[:n3]]
@@ -308,8 +469,20 @@ period. For the orbits' character we use the bifurcation diagram over speed belo
 
 ![orbits against speed](press_speed_orbits.png)
 
-{_table(["clearance at", "c [mm]", "crank 2 speed [rad/s]", "peak force at A [N]", "95th pct. force at A [N]",
-         "acc. peak [m/s²]", "time in flight at A"], rows)}
+{
+        _table(
+            [
+                "clearance at",
+                "c [mm]",
+                "crank 2 speed [rad/s]",
+                "peak force at A [N]",
+                "95th pct. force at A [N]",
+                "acc. peak [m/s²]",
+                "time in flight at A",
+            ],
+            rows,
+        )
+    }
 Regimes in the speed diagram: {frac(low):.0%} chaotic over the lowest third of the speeds
 ({", ".join(low)}), {frac(high):.0%} over the highest third ({", ".join(high)}).
 Criterion: the contact force rises with speed (Spearman > 0.9 of its 95th percentile for
@@ -324,7 +497,9 @@ loaded arc, and what changes with speed is whether that sliding repeats from one
 to the next (figure: the periods retrace one path at the lower speeds and separate at
 the highest). In the diagram over speed the
 section points move steadily and spread a little, and the motion turns chaotic only at the
-top of the range ({"no chaotic point" if first_chaos is None else f"from {first_chaos:.2f}π rad/s"}): the finding holds, but our press stays
+top of the range ({
+        "no chaotic point" if first_chaos is None else f"from {first_chaos:.2f}π rad/s"
+    }): the finding holds, but our press stays
 periodic over most of the seed's speed range at this clearance, without the flights across
 the clearance that the seed's orbits suggest.
 """
@@ -343,14 +518,33 @@ def finding_poincare(press: Press, out: Path):
         flights.append(float(np.mean(r.joints["A"].penetration[r.times >= plan.POINCARE_SKIP * T] <= 0)))
         panels.append(PoincarePanel(sec.points, ("A.ex", "A.ey"), cl, sec.trajectory, f"c = {c:g} mm"))
         spread = float(np.sqrt(np.mean(np.sum((sec.points - sec.points.mean(axis=0)) ** 2, axis=1))))
-        rows.append([_g(c), len(sec.points), cl.regime.value.replace("_", "-"), cl.distinct,
-                     _g(cl.divergence), _g(cl.correlation_dimension), f"{spread * 1e6:.3g}", f"{sec.scale * 1e6:.3g}"])
-    plot_poincare_panels(panels, title=f"press, clearance at A and C, crank 2 at {w:g}π rad/s: journal centre at A "
-                         "once per period", path=out / "press_poincare.png")
+        rows.append(
+            [
+                _g(c),
+                len(sec.points),
+                cl.regime.value.replace("_", "-"),
+                cl.distinct,
+                _g(cl.divergence),
+                _g(cl.correlation_dimension),
+                f"{spread * 1e6:.3g}",
+                f"{sec.scale * 1e6:.3g}",
+            ]
+        )
+    plot_poincare_panels(
+        panels,
+        title=f"press, clearance at A and C, crank 2 at {w:g}π rad/s: journal centre at A once per period",
+        path=out / "press_poincare.png",
+    )
     small, large = regimes[plan.POINCARE_CLEARANCES_MM[0]], regimes[plan.POINCARE_CLEARANCES_MM[-1]]
-    verdict = (HOLDS if small == "quasi_periodic" and large == "chaotic"
-               else PARTLY if large == "chaotic" and small in ("periodic", "quasi_periodic") else FAILS)
-    text = f"""Clearance at A and C, {" and ".join(_g(c) for c in plan.POINCARE_CLEARANCES_MM)} mm, crank 2 at {w:g}π rad/s,
+    verdict = (
+        HOLDS
+        if small == "quasi_periodic" and large == "chaotic"
+        else PARTLY
+        if large == "chaotic" and small in ("periodic", "quasi_periodic")
+        else FAILS
+    )
+    text = f"""Clearance at A and C, {" and ".join(_g(c) for c in plan.POINCARE_CLEARANCES_MM)} mm, crank 2 at {
+        w:g}π rad/s,
 {plan.POINCARE_PERIODS} periods at {plan.PRESS_LONG_STEP * 1e6:g} µs; the journal centre at A (bearing frame) sampled
 at t = kT after the first {plan.POINCARE_SKIP} periods and classified by
 `clearance.analysis.chaos.poincare.classify_poincare` (coinciding points → periodic; otherwise the
@@ -359,15 +553,30 @@ else quasi-periodic).
 
 ![Poincaré sections](press_poincare.png)
 
-{_table(["c [mm]", "points", "regime", "distinct groups", "divergence [-]", "correlation dim. [-]",
-         "section spread [µm]", "orbit size [µm]"], rows)}
+{
+        _table(
+            [
+                "c [mm]",
+                "points",
+                "regime",
+                "distinct groups",
+                "divergence [-]",
+                "correlation dim. [-]",
+                "section spread [µm]",
+                "orbit size [µm]",
+            ],
+            rows,
+        )
+    }
 Criterion: quasi-periodic (a closed curve) at the small clearance and chaotic (scattered) at
 the large one; "partly" if the small clearance gives a periodic orbit (a point or a few
 points) instead of a closed curve.
 
 Why: in our press the journal at A slides round its bearing wall once per crank turn
 (grey: the orbit follows the clearance circle). At {_g(plan.POINCARE_CLEARANCES_MM[0])} mm it does so in step with
-the drive, so the section is {"a single point (period 1)" if small == "periodic" else small.replace("_", "-")}; at {_g(plan.POINCARE_CLEARANCES_MM[-1])} mm the
+the drive, so the section is {"a single point (period 1)" if small == "periodic" else small.replace("_", "-")}; at {
+        _g(plan.POINCARE_CLEARANCES_MM[-1])
+    } mm the
 sliding no longer repeats from one turn to the next (the journal also leaves the wall
 briefly, {flights[-1]:.1%} of the time after the transient), and the section points scatter
 along the loaded arc ({large.replace("_", "-")}). A closed curve needs a second frequency that does not divide
