@@ -20,16 +20,42 @@ from clearance.mjcf import (
 from clearance.options import ContactParameters, GeomType, ModelOptions
 from clearance.run.preparation import prepare
 
-GOLDEN = Path(__file__).parent / "golden" / "slider_crank.xml"
+GOLDEN_DIR = Path(__file__).parent / "golden"
+GOLDEN = GOLDEN_DIR / "slider_crank.xml"
+
+
+def _check_golden(xml: str, path: Path) -> None:
+    if os.environ.get("CLEARANCE_UPDATE_GOLDEN"):
+        path.write_text(xml)
+    assert path.exists(), f"no golden file {path.name}: generate it with CLEARANCE_UPDATE_GOLDEN=1"
+    assert xml == path.read_text(), f"{path.name} differs: regenerate with CLEARANCE_UPDATE_GOLDEN=1 after a deliberate change"
 
 
 def test_golden_mjcf_for_default_slider_crank(default_mechanism):
     # nominal contact: closed-form parameters, so the file is the same on every machine (a
     # calibrated run's fitted values carry the fit's last digits; their test is elsewhere)
     xml = prepare(default_mechanism, ModelOptions(contact_mode="nominal")).to_xml()
-    if os.environ.get("CLEARANCE_UPDATE_GOLDEN"):
-        GOLDEN.write_text(xml)
-    assert xml == GOLDEN.read_text(), "regenerate with CLEARANCE_UPDATE_GOLDEN=1 after a deliberate change"
+    _check_golden(xml, GOLDEN)
+
+
+def _catalogue_names() -> list[str]:
+    from clearance.builders import CATALOGUE
+
+    return sorted(CATALOGUE)
+
+
+@pytest.mark.parametrize("name", _catalogue_names())
+def test_golden_mjcf_per_builder(name):
+    """Every catalogue builder at its defaults gives the same MJCF as its golden file.
+
+    Nominal contact (closed-form parameters: the same on every machine) and 36 segments per
+    bearing keep the files small; the segment rule is covered by the default slider-crank's
+    golden file above.
+    """
+    from clearance.builders import CATALOGUE
+
+    xml = prepare(CATALOGUE[name].builder(), ModelOptions(contact_mode="nominal", segments=36)).to_xml()
+    _check_golden(xml, GOLDEN_DIR / f"builder_{name}.xml")
 
 
 def _step_without_warnings(xml: str, steps: int = 2000) -> mujoco.MjData:
