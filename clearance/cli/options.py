@@ -24,6 +24,7 @@ __all__ = [
     "NUMERICS_FLAGS",
     "si",
     "positive",
+    "add_clearance_mm",
     "add_sweep_args",
     "sweep_out",
     "sweep_options",
@@ -105,12 +106,7 @@ def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, cont
         help="scenario file (a catalogue builder with overrides, or a whole mechanism); "
         "replaces --mechanism and the options below",
     )
-    g.add_argument(
-        "--clearance-mm",
-        type=positive(float, "--clearance-mm"),
-        default=None,
-        help="radial clearance c [mm] (default: the builder's; 0.5 for the slider-crank)",
-    )
+    add_clearance_mm(g)
     g.add_argument(
         "--clearance-at",
         nargs="*",
@@ -229,6 +225,22 @@ def options_from_args(args: argparse.Namespace) -> ModelOptions:
         journal_geom=args.journal_geom,
         segment_geom=args.segment_geom,
         contact_mode=getattr(args, "contact_mode", None) or ModelOptions().contact_mode,
+    )
+
+
+def add_clearance_mm(p: argparse.ArgumentParser | argparse._ArgumentGroup, *, what: str = "") -> None:
+    """Add ``--clearance-mm`` (None: the builder's default clearance), the one definition every command uses.
+
+    Args:
+        p: the parser or argument group.
+        what: when the option applies, for the help text (e.g. "when sweeping speed").
+    """
+    p.add_argument(
+        "--clearance-mm",
+        type=positive(float, "--clearance-mm"),
+        default=None,
+        help=f"radial clearance c [mm]{' ' + what if what else ''} (default: the builder's; 0.5 for the "
+        "slider-crank, 0.1 for the other catalogue mechanisms)",
     )
 
 

@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 from collections.abc import Sequence
 
-from clearance.cli.options import add_sweep_args, positive, si, sweep_options, sweep_out
+from clearance.cli.options import add_clearance_mm, add_sweep_args, positive, si, sweep_options, sweep_out
 from clearance.cli.sweep_common import (
     UsageError,
     catalogue_entry,
@@ -43,9 +43,7 @@ def sweep_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--points", type=int, default=200, help="number of values (default 200)")
     p.add_argument("--log", action="store_true", help="logarithmic spacing")
-    p.add_argument(
-        "--clearance-mm", type=positive(float, "--clearance-mm"), default=0.5, help="clearance when sweeping speed [mm]"
-    )
+    add_clearance_mm(p, what="when sweeping speed")
     p.add_argument(
         "--rpm",
         type=positive(float, "--rpm"),
@@ -88,7 +86,8 @@ def main_sweep(argv: Sequence[str] | None = None) -> int:
         key = entry.speed_keyword
         lo = entry.speed_range[0] if args.start is None else si(args.start, "rpm")
         hi = entry.speed_range[1] if args.stop is None else si(args.stop, "rpm")
-        fixed["radial_clearance"] = si(args.clearance_mm, "mm")
+        if args.clearance_mm is not None:
+            fixed["radial_clearance"] = si(args.clearance_mm, "mm")
     if args.points < 1:
         return usage_error(f"--points must be at least 1 (got {args.points})")
     values = (np.geomspace if args.log else np.linspace)(lo, hi, args.points)
