@@ -12,8 +12,9 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike, NDArray
 
-from clearance.model import DriveKind, JointType, Mechanism
+from clearance.model import Drive, DriveKind, JointType, Mechanism
 
 __all__ = ["ConstraintSystem"]
 
@@ -59,10 +60,10 @@ class _Held:
         self.name = name
         self.start_angle = angle
 
-    def angle(self, t):
+    def angle(self, t: ArrayLike) -> NDArray[np.float64]:
         return self.start_angle + 0.0 * np.asarray(t, dtype=float)
 
-    def rate(self, t):
+    def rate(self, t: ArrayLike) -> NDArray[np.float64]:
         return 0.0 * np.asarray(t, dtype=float)
 
     acceleration = rate
@@ -107,7 +108,8 @@ class ConstraintSystem:
             off = guess[j.link_b][2] - guess[j.link_a][2]
             self.pairs.append(_Pair(j.kind, index[j.link_a], index[j.link_b], pa, pb, u, off))
             self.pair_names.append(j.name)
-        self.drives = []
+        # (drive or held torque drive, index of link a, index of link b; -1 for ground) per drive row
+        self.drives: list[tuple[Drive | _Held, int, int]] = []
         if include_drives:
             for d in mechanism.drives:
                 jt = mechanism.joint(d.joint)

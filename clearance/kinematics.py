@@ -394,7 +394,7 @@ def output_kinematics(mechanism: Mechanism, q: np.ndarray, qd: np.ndarray, qdd: 
         if o.kind is OutputKind.ANGLE:
             out[o.name], out[o.name + "_vel"], out[o.name + "_acc"] = th.copy(), w.copy(), al.copy()
             continue
-        px, py = mechanism.link(o.link).point(o.point)
+        px, py = mechanism.link(o.link).point(o.require_point())
         c, s = np.cos(th), np.sin(th)
         rp = np.stack([c * px - s * py, s * px + c * py], axis=-1)  # R p
         drp = np.stack([-s * px - c * py, c * px - s * py], axis=-1)  # R' p
@@ -461,6 +461,7 @@ def transmission_angle(mechanism: Mechanism, q: np.ndarray, spec: TransmissionAn
         v = link_point_world(mechanism, q, flink, mechanism.link(flink).point(fpoint)) - pj
         v = v / np.linalg.norm(v, axis=-1, keepdims=True)
         return np.arccos(np.clip(np.sum(u * v, axis=-1), -1.0, 1.0))
+    assert spec.guide is not None  # TransmissionAngle holds a follower or a guide
     guide = mechanism.joint(spec.guide)
     if guide.link_a == mechanism.ground:
         th = np.zeros(q.shape[:-1])

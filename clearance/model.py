@@ -24,9 +24,13 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from types import MappingProxyType
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from clearance.checks import finite, positive
+
+if TYPE_CHECKING:  # numpy is imported where it is used: `import clearance` stays cheap
+    import numpy as np
+    from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "ContactLaw",
@@ -88,7 +92,7 @@ def _point(name: str, value: Any) -> tuple[float, float]:
     return (finite(f"{name}[0]", x), finite(f"{name}[1]", y))
 
 
-def _name(field_name: str, value: Any) -> str:
+def _name(field_name: str, value: object) -> str:
     if not isinstance(value, str) or not value or not value.replace("_", "").replace("-", "").isalnum():
         raise ValueError(f"{field_name} must be a non-empty name of letters, digits, '_' or '-' (got {value!r})")
     return value
@@ -267,6 +271,16 @@ class Joint:
                     f"'{self.link_b}' (got '{jl}')"
                 )
 
+    def require_clearance(self) -> Clearance:
+        """The joint's clearance, for code that handles clearance joints only.
+
+        Raises:
+            ValueError: the joint is ideal (it has no clearance).
+        """
+        if self.clearance is None:
+            raise ValueError(f"joint '{self.name}' is an ideal joint: it has no clearance")
+        return self.clearance
+
 
 @dataclass(frozen=True)
 class MotionLaw:
@@ -298,18 +312,18 @@ class MotionLaw:
         """Fundamental angular frequency [rad/s]."""
         return 2 * math.pi / self.period if self.period is not None else abs(self.speed)
 
-    def offset(self, t: Any) -> Any:
+    def offset(self, t: ArrayLike) -> NDArray[np.float64]:
         """theta(t) - theta0 [rad] for scalar or array t [s]."""
         import numpy as np
 
         t = np.asarray(t, dtype=float)
         w = self.fundamental
-        out = self.speed * t
+        out: NDArray[np.float64] = self.speed * t
         for k, (a, ph) in enumerate(self.harmonics, start=1):
             out = out + a * (np.sin(k * w * t + ph) - math.sin(ph))
         return out
 
-    def rate(self, t: Any) -> Any:
+    def rate(self, t: ArrayLike) -> NDArray[np.float64]:
         """theta'(t) [rad/s]."""
         import numpy as np
 
@@ -320,7 +334,7 @@ class MotionLaw:
             out = out + a * k * w * np.cos(k * w * t + ph)
         return out
 
-    def acceleration(self, t: Any) -> Any:
+    def acceleration(self, t: ArrayLike) -> NDArray[np.float64]:
         """theta''(t) [rad/s^2]."""
         import numpy as np
 
@@ -367,37 +381,49 @@ class Drive:
         if self.kind is DriveKind.MOTION_LAW and not isinstance(self.motion, MotionLaw):
             raise ValueError(f"drive '{self.name}' needs a MotionLaw in 'motion' (got {self.motion!r})")
 
-    def angle(self, t: Any) -> Any:
+    def require_motion(self) -> MotionLaw:
+        """The drive's motion law, for code that handles motion-law drives only.
+
+        Raises:
+            ValueError: the drive has no motion law (it is not a MOTION_LAW drive).
+        """
+        if self.motion is None:
+            raise ValueError(f"drive '{self.name}' ({self.kind.value}) has no motion law")
+        return self.motion
+
+    def angle(self, t: ArrayLike) -> NDArray[np.float64]:
         """Prescribed drive angle [rad] at time(s) t [s] (not defined for torque drives)."""
+        import numpy as np
+
         if self.kind is DriveKind.MOTION_LAW:
-            return self.start_angle + self.motion.offset(t)
+            return self.start_angle + self.require_motion().offset(t)
         if self.kind is DriveKind.CONSTANT_SPEED:
-            return self.start_angle + self.speed * t
+            return self.start_angle + self.speed * np.asarray(t, dtype=float)
         raise ValueError(f"drive '{self.name}' is a torque drive: its angle is not prescribed")
 
-    def rate(self, t: Any) -> Any:
+    def rate(self, t: ArrayLike) -> NDArray[np.float64]:
         """Prescribed drive speed [rad/s] at time(s) t [s]."""
         import numpy as np
 
         if self.kind is DriveKind.MOTION_LAW:
-            return self.motion.rate(t)
+            return self.require_motion().rate(t)
         if self.kind is DriveKind.CONSTANT_SPEED:
             return np.full_like(np.asarray(t, dtype=float), self.speed)
         raise ValueError(f"drive '{self.name}' is a torque drive: its speed is not prescribed")
 
-    def acceleration(self, t: Any) -> Any:
+    def acceleration(self, t: ArrayLike) -> NDArray[np.float64]:
         """Prescribed drive acceleration [rad/s^2] at time(s) t [s]."""
         import numpy as np
 
         if self.kind is DriveKind.MOTION_LAW:
-            return self.motion.acceleration(t)
+            return self.require_motion().acceleration(t)
         return np.zeros_like(np.asarray(t, dtype=float))
 
     @property
     def period(self) -> float:
         """Drive period [s]: one revolution at the drive's (mean) speed, or the law's period."""
         if self.kind is DriveKind.MOTION_LAW:
-            return 2 * math.pi / self.motion.fundamental
+            return 2 * math.pi / self.require_motion().fundamental
         if self.kind is DriveKind.CONSTANT_SPEED:
             return 2 * math.pi / abs(self.speed)
         raise ValueError(f"drive '{self.name}' is a torque drive: it has no set period")
@@ -426,6 +452,16 @@ class Output:
             raise ValueError(f"output '{self.name}' kind must be an OutputKind (got {self.kind!r})")
         if self.kind is not OutputKind.ANGLE and self.point is None:
             raise ValueError(f"output '{self.name}' ({self.kind.value}) needs a point")
+
+    def require_point(self) -> str:
+        """The point of a position output.
+
+        Raises:
+            ValueError: the output has no point (an ANGLE output).
+        """
+        if self.point is None:
+            raise ValueError(f"output '{self.name}' ({self.kind.value}) has no point")
+        return self.point
 
 
 def _unique(kind: str, names: list[str]) -> None:

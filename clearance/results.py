@@ -200,7 +200,8 @@ class SimulationResult:
             for f in _JOINT_FIELDS:
                 arrays[f"joint/{j}/{f}"] = getattr(jr, f)
         buf = io.BytesIO()
-        np.savez_compressed(buf, **arrays)
+        # numpy's stubs type **kwds against the allow_pickle keyword (absent before numpy 2.1) too
+        np.savez_compressed(buf, **arrays)  # type: ignore[arg-type]
         npz, js = stem.with_suffix(".npz"), stem.with_suffix(".json")
         meta = dict(self.metadata)
         meta["output_names"] = list(self.outputs)
@@ -230,7 +231,7 @@ class SimulationResult:
             )
 
 
-def _json_default(o: Any) -> Any:
+def _json_default(o: object) -> object:
     if isinstance(o, np.ndarray):
         return o.tolist()
     if isinstance(o, (np.floating, np.integer)):

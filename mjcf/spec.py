@@ -27,7 +27,7 @@ import numpy as np
 from clearance.kinematics import assemble, velocities
 from clearance.mjcf.bearing import RingGeometry, segment_centres
 from clearance.mjcf.tree import BodyTree, body_tree
-from clearance.model import DriveKind, Joint, JointType, Mechanism, OutputKind
+from clearance.model import DriveKind, Joint, JointType, Link, Mechanism, OutputKind
 from clearance.options import GeomType, ModelOptions
 
 __all__ = ["BuiltModel", "build_spec", "drive_armature", "drive_gear", "ring_geometry"]
@@ -63,7 +63,7 @@ class BuiltModel:
 
 def ring_geometry(joint: Joint, segments: int, options: ModelOptions) -> RingGeometry:
     """Ring geometry of a clearance joint for the chosen geoms and segment count."""
-    c = joint.clearance
+    c = joint.require_clearance()
     n_pc = 2 if (options.journal_geom is GeomType.CAPSULE and options.segment_geom is GeomType.CAPSULE) else 1
     return RingGeometry.make(
         c.bearing_radius,
@@ -94,7 +94,15 @@ def _to_frame(pose: np.ndarray, world: np.ndarray) -> np.ndarray:
     return np.array([c * d[0] + s * d[1], -s * d[0] + c * d[1]])
 
 
-def _sensor(spec, name, stype, objtype, objname, reftype=None, refname=""):
+def _sensor(
+    spec: mujoco.MjSpec,
+    name: str,
+    stype: mujoco.mjtSensor,
+    objtype: mujoco.mjtObj,
+    objname: str,
+    reftype: mujoco.mjtObj | None = None,
+    refname: str = "",
+) -> mujoco.MjsSensor:
     s = spec.add_sensor(name=name, type=stype, objtype=objtype, objname=objname)
     if reftype is not None:
         s.reftype = reftype
@@ -213,14 +221,15 @@ def build_spec(
 
     rings, jbody, bbody = {}, {}, {}
     for j in mechanism.clearance_joints:
-        c = j.clearance
-        jl = c.journal_link
+        cl = j.require_clearance()
+        jl = cl.journal_link
+        assert jl is not None  # Mechanism resolves the journal side of every clearance
         bl = j.link_b if jl == j.link_a else j.link_a
         jp = links[jl].point(j.point_a if jl == j.link_a else j.point_b)
         bp = links[bl].point(j.point_a if bl == j.link_a else j.point_b)
         ring = ring_geometry(j, segments[j.name], options)
         rings[j.name], jbody[j.name], bbody[j.name] = ring, jl, bl
-        _journal_and_bearing(spec, bodies[jl], bodies[bl], j.name, jp, bp, ring, options, c.friction)
+        _journal_and_bearing(spec, bodies[jl], bodies[bl], j.name, jp, bp, ring, options, cl.friction)
         _site(bodies[jl], f"{j.name}__journal", jp)
         _site(bodies[bl], f"{j.name}__bearing", bp)
         _sensor(
@@ -257,7 +266,7 @@ def build_spec(
             _sensor(spec, f"{o.name}__angvel", _SENS.mjSENS_FRAMEANGVEL, _OBJ.mjOBJ_BODY, o.link)
             _sensor(spec, f"{o.name}__angacc", _SENS.mjSENS_FRAMEANGACC, _OBJ.mjOBJ_BODY, o.link)
         else:
-            _site(bodies[o.link], f"{o.name}__site", links[o.link].point(o.point))
+            _site(bodies[o.link], f"{o.name}__site", links[o.link].point(o.require_point()))
             for suffix, st in (
                 ("pos", _SENS.mjSENS_FRAMEPOS),
                 ("vel", _SENS.mjSENS_FRAMELINVEL),
@@ -306,11 +315,11 @@ def drive_armature(mechanism: Mechanism) -> float:
     return 100.0 * inertia
 
 
-def _site(body, name: str, p: tuple[float, float]) -> None:
+def _site(body: mujoco.MjsBody, name: str, p: tuple[float, float]) -> None:
     body.add_site(name=name, pos=[p[0], p[1], 0.0], size=[0.001, 0, 0], group=3)
 
 
-def _visual_link(body, link) -> None:
+def _visual_link(body: mujoco.MjsBody, link: Link) -> None:
     pts = list(link.points.values())
     rgba = [0.55, 0.6, 0.7, 1.0]
     kw = dict(contype=0, conaffinity=0, group=1, rgba=rgba, mass=0)
@@ -340,7 +349,15 @@ def _geom_type(g: GeomType) -> int:
 
 
 def _journal_and_bearing(
-    spec, jbody, bbody, name, jp, bp, ring: RingGeometry, options: ModelOptions, friction: float
+    spec: mujoco.MjSpec,
+    jbody: mujoco.MjsBody,
+    bbody: mujoco.MjsBody,
+    name: str,
+    jp: tuple[float, float],
+    bp: tuple[float, float],
+    ring: RingGeometry,
+    options: ModelOptions,
+    friction: float,
 ) -> None:
     nocol = dict(contype=0, conaffinity=0)
     jg = options.journal_geom

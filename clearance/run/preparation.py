@@ -26,7 +26,7 @@ from clearance.mjcf import (
     build_spec,
     choose_segments,
 )
-from clearance.model import DriveKind, Mechanism
+from clearance.model import DriveKind, Joint, Mechanism
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
 
 __all__ = ["JointSizing", "PreparedModel", "prepare", "initial_controls", "TimeStepError"]
@@ -117,7 +117,7 @@ def prepare(
     segs: dict[str, int] = {}
     pre: dict[str, tuple[float, float, float, float]] = {}
     for j in cjoints:
-        c = j.clearance
+        c = j.require_clearance()
         K = bearing_stiffness(c)
         f = loads[j.name]
         fmed, fmax = float(np.median(f)), float(np.max(f))
@@ -137,7 +137,7 @@ def prepare(
     for j in cjoints:
         K, fmed, fmax, dtyp = pre[j.name]
         m = masses[j.name].median
-        v = math.sqrt(2 * max(fmax, 1e-9) * j.clearance.radial_clearance / m)
+        v = math.sqrt(2 * max(fmax, 1e-9) * j.require_clearance().radial_clearance / m)
         d_imp = (5 * m * v**2 / (4 * K)) ** 0.4
         lim = 4 * max(d_imp, (max(fmax, 1e-9) / K) ** (2 / 3))
         sizing[j.name] = JointSizing(K, fmed, fmax, dtyp, v, m, lim, segs[j.name], masses[j.name].valid_range)
@@ -172,7 +172,7 @@ def initial_controls(mechanism: Mechanism) -> np.ndarray:
     return np.array([d.torque if d.kind is DriveKind.TORQUE else float(d.rate(0.0)) for d in mechanism.drives])
 
 
-def _contact_for(joint, built: BuiltModel, sizing: JointSizing, options: ModelOptions) -> ContactParameters:
+def _contact_for(joint: Joint, built: BuiltModel, sizing: JointSizing, options: ModelOptions) -> ContactParameters:
     from clearance.contact_calibration.nominal import nominal_parameters
 
     ring = built.rings[joint.name]
@@ -182,7 +182,7 @@ def _contact_for(joint, built: BuiltModel, sizing: JointSizing, options: ModelOp
         except ImportError:
             raise ValueError("contact_mode 'calibrated' is not available in this version; use 'nominal'") from None
         return calibrated_parameters(joint, ring, sizing, options)
-    return nominal_parameters(joint.clearance, ring, effective_mass=sizing.effective_mass)
+    return nominal_parameters(joint.require_clearance(), ring, effective_mass=sizing.effective_mass)
 
 
 def _check_time_step(name: str, s: JointSizing, h: float) -> None:

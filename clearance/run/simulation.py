@@ -18,11 +18,15 @@ from mujoco import rollout
 
 from clearance.model import DriveKind, Mechanism
 from clearance.options import ContactMode, ContactParameters, ModelOptions
+from clearance.results import SimulationResult
 from clearance.run.preparation import PreparedModel, prepare
 from clearance.run.readout import read_sensors
 from clearance.version import __version__
 
 __all__ = ["SimulationError", "simulate", "simulate_prepared", "default_duration"]
+
+_Stepper = Callable[[np.ndarray, int], tuple[np.ndarray, np.ndarray, mujoco.MjData]]
+"""(controls (1 or n, nu), n) -> (states (n, nstate), sensors (n, nsensordata), data) of n steps."""
 
 
 class SimulationError(RuntimeError):
@@ -35,7 +39,14 @@ class SimulationError(RuntimeError):
             when the cause cannot be tied to one joint (a non-finite state, a MuJoCo warning).
     """
 
-    def __init__(self, message: str, partial=None, *, time: float | None = None, joint: str | None = None):
+    def __init__(
+        self,
+        message: str,
+        partial: SimulationResult | None = None,
+        *,
+        time: float | None = None,
+        joint: str | None = None,
+    ) -> None:
         super().__init__(message)
         self.partial = partial
         self.time = time
@@ -70,7 +81,7 @@ def simulate(
     progress: bool | Callable[[float], None] = False,
     chunk_steps: int = 100_000,
     initial_eccentricity: Mapping[str, tuple[float, float]] | None = None,
-):
+) -> SimulationResult:
     """Simulate a mechanism with clearance joints in MuJoCo.
 
     Args:
@@ -106,6 +117,7 @@ def simulate(
         raise ValueError(f"output_interval must be > 0 s (got {output_interval!r})")
     if not isinstance(chunk_steps, int) or chunk_steps < 1:
         raise ValueError(f"chunk_steps must be a positive integer (got {chunk_steps!r})")
+    _step_count(duration, options.timestep)
     if initial_eccentricity is not None:
         names = {j.name for j in mechanism.clearance_joints}
         for k, v in dict(initial_eccentricity).items():
@@ -134,13 +146,11 @@ def simulate_prepared(
     progress: bool | Callable[[float], None] = False,
     chunk_steps: int = 100_000,
     initial_eccentricity: Mapping[str, tuple[float, float]] | None = None,
-):
+) -> SimulationResult:
     """Run an already prepared model (see `simulate` for the arguments)."""
-    from clearance.results import SimulationResult
-
     model, mech = prepared.model, prepared.mechanism
     h = model.opt.timestep
-    nstep = int(round(duration / h))
+    nstep = _step_count(duration, h)
     every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
     qpos0 = _initial_qpos(prepared, initial_eccentricity)
     # exact-LN mode imposes LN on clearance joints' rows; a model without any (the ideal
@@ -186,7 +196,15 @@ def simulate_prepared(
     return _finish(parts, prepared, t0, nstep_done=nstep, every=every)
 
 
-def _thin(part, first_step: int, every: int):
+def _step_count(duration: float, h: float) -> int:
+    """Steps of ``h`` [s] in ``duration`` [s], at least one."""
+    nstep = int(round(duration / h))
+    if nstep < 1:
+        raise ValueError(f"duration must be at least half a time step ({h / 2:g} s; got {duration!r} s)")
+    return nstep
+
+
+def _thin(part: SimulationResult, first_step: int, every: int) -> SimulationResult:
     """Rows of a chunk starting at step ``first_step`` whose step index is a multiple of ``every``.
 
     Thinning each chunk as it comes keeps memory bounded by the stored rows, not the steps.
@@ -197,12 +215,12 @@ def _thin(part, first_step: int, every: int):
 class _StepFailure(Exception):
     """A stepper stopped at its first bad step; carries the rows before it and the reason."""
 
-    def __init__(self, states, sens, data, reason: str):
+    def __init__(self, states: np.ndarray, sens: np.ndarray, data: mujoco.MjData, reason: str) -> None:
         super().__init__(reason)
         self.states, self.sens, self.data, self.reason = states, sens, data, reason
 
 
-def _initial_qpos(prepared: PreparedModel, targets) -> np.ndarray | None:
+def _initial_qpos(prepared: PreparedModel, targets: Mapping[str, tuple[float, float]] | None) -> np.ndarray | None:
     """qpos with journals moved to ``targets`` (None: the keyframe's)."""
     if not targets:
         return None
@@ -210,7 +228,7 @@ def _initial_qpos(prepared: PreparedModel, targets) -> np.ndarray | None:
 
     model, mech = prepared.model, prepared.mechanism
     for k, v in targets.items():
-        c = mech.joint(k).clearance.radial_clearance
+        c = mech.joint(k).require_clearance().radial_clearance
         lim = prepared.sizing[k].penetration_limit
         if np.hypot(*v) > c + lim:
             raise ValueError(
@@ -221,7 +239,7 @@ def _initial_qpos(prepared: PreparedModel, targets) -> np.ndarray | None:
         model,
         model.key_qpos[0],
         targets,
-        bearings={k: mech.joint(k).clearance.radial_clearance for k in targets},
+        bearings={k: mech.joint(k).require_clearance().radial_clearance for k in targets},
         fixed_joints=[d.joint for d in mech.drives],
     )
 
@@ -234,7 +252,7 @@ def _start(model: mujoco.MjModel, qpos0: np.ndarray | None) -> mujoco.MjData:
     return data
 
 
-def _rollout_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
+def _rollout_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None) -> _Stepper:
     """Chunks with `mujoco.rollout` (no Python per step)."""
     model = prepared.model
     data = _start(model, qpos0)
@@ -243,7 +261,7 @@ def _rollout_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
     mujoco.mj_getState(model, data, state, kind)
     box = {"state": state}
 
-    def step(ctrl: np.ndarray, n: int):
+    def step(ctrl: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, mujoco.MjData]:
         start, before = box["state"], _warning_count(data)
         states, sens = rollout.rollout(model, data, start[None], ctrl[None], nstep=n)
         states, sens = states[0], sens[0]
@@ -279,7 +297,7 @@ def _first_warning_step(model: mujoco.MjModel, state: np.ndarray, ctrl: np.ndarr
     return k, fired
 
 
-def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
+def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None) -> _Stepper:
     """Chunks with the exact-LN step loop (LN force imposed on the ring rows each step)."""
     import copy
 
@@ -291,15 +309,15 @@ def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
 
     model = copy.copy(prepared.model)  # ExactLNContact raises pair margins in place
     for j in prepared.mechanism.clearance_joints:
-        if j.clearance.friction > 0:
+        if j.require_clearance().friction > 0:
             raise ValueError(
                 f"contact_mode 'exact_ln' supports frictionless joints only (joint '{j.name}' has "
-                f"friction {j.clearance.friction}); use 'calibrated'"
+                f"friction {j.require_clearance().friction}); use 'calibrated'"
             )
     contacts = [
         ExactLNContact(
             model,
-            j.clearance,
+            j.require_clearance(),
             prepared.built.rings[j.name],
             journal_geom=f"{j.name}__journal",
             bearing_site=f"{j.name}__bearing",
@@ -308,7 +326,7 @@ def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None):
     ]
     data = _start(model, qpos0)
 
-    def step(ctrl: np.ndarray, n: int):
+    def step(ctrl: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, mujoco.MjData]:
         try:
             run = step_exact_ln(model, data, contacts, n, ctrl=ctrl if len(ctrl) == n else ctrl[0])
         except ExactLNStepError as err:
@@ -326,11 +344,9 @@ def _remedy(prepared: PreparedModel) -> str:
     )
 
 
-def _finish(parts, prepared: PreparedModel, t0: float, *, nstep_done: int, every: int):
-    from clearance.results import SimulationResult
-
-    if not parts:
-        return None
+def _finish(
+    parts: list[SimulationResult], prepared: PreparedModel, t0: float, *, nstep_done: int, every: int
+) -> SimulationResult:
     res = SimulationResult.concatenate(parts)
     wall = _time.perf_counter() - t0
     mech = prepared.mechanism
@@ -353,8 +369,14 @@ def _finish(parts, prepared: PreparedModel, t0: float, *, nstep_done: int, every
 
 
 def _first_bad(
-    prepared: PreparedModel, data: mujoco.MjData, part, states: np.ndarray, sens: np.ndarray, *, warnings: bool = True
-):
+    prepared: PreparedModel,
+    data: mujoco.MjData,
+    part: SimulationResult,
+    states: np.ndarray,
+    sens: np.ndarray,
+    *,
+    warnings: bool = True,
+) -> tuple[int, str | None, str, str] | None:
     """(row index, joint or None, reason, remedy) of a chunk's first bad row, or None.
 
     Rows from the index on are dropped. A row is bad when its journal is beyond the
@@ -366,14 +388,14 @@ def _first_bad(
     n = len(part.times)
     finite = np.isfinite(states[:n]).all(axis=1) & np.isfinite(sens[:n]).all(axis=1)
     first_nan = int(np.argmin(finite)) if not finite.all() else n
-    worst = (n, None, None)
+    worst: tuple[int, str, float] | None = None  # (row, joint, penetration) of the first row beyond a bound
     for name, jr in part.joints.items():
         lim = prepared.sizing[name].penetration_limit
         over = np.nonzero(jr.penetration > lim)[0]
-        if len(over) and over[0] < worst[0]:
+        if len(over) and (worst is None or over[0] < worst[0]):
             worst = (int(over[0]), name, float(jr.penetration[over[0]]))
     remedy = _remedy(prepared)
-    if worst[1] is not None and worst[0] <= first_nan:
+    if worst is not None and worst[0] <= first_nan:
         lim = prepared.sizing[worst[1]].penetration_limit
         return (
             worst[0],
@@ -393,7 +415,7 @@ def _first_bad(
     return None
 
 
-def _progress(progress, total: int):
+def _progress(progress: bool | Callable[[float], None], total: int) -> Callable[[int | None], None]:
     if callable(progress):
         return lambda done: progress(1.0 if done is None else done / total)
     if not progress:
@@ -402,7 +424,7 @@ def _progress(progress, total: int):
 
     bar = tqdm(total=total, unit="step", unit_scale=True, desc="simulate", leave=False)
 
-    def update(done):
+    def update(done: int | None) -> None:
         if done is None:
             bar.close()
         else:
