@@ -294,7 +294,8 @@ def correlation_dimension(points: np.ndarray, *, r_quantiles: tuple[float, float
     d = d[d > 0]
     if len(d) < 10:
         return float("nan")
-    r = np.geomspace(*np.quantile(d, r_quantiles), 12)
+    r_lo, r_hi = np.quantile(d, r_quantiles)
+    r = np.geomspace(r_lo, r_hi, 12)
     c = np.searchsorted(d, r) / len(d)
     ok = c > 0
     if np.count_nonzero(ok) < 3:
@@ -416,7 +417,7 @@ def largest_lyapunov(
         grow = np.nonzero(sep > 10 * d0)[0]
         sat = np.nonzero(sep > 0.1 * size)[0]
         if len(grow) and len(sat) and sat[0] > grow[0] + 2:
-            sel = slice(grow[0], sat[0])
+            sel: slice | np.ndarray = slice(grow[0], sat[0])
         else:
             sel = slice(0, len(t))
     else:

@@ -15,6 +15,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.figure import Figure
 
 from clearance.analysis.chaos.poincare import PhasePortrait, PoincareClassification
 from clearance.analysis.figures.plots import save_figure
@@ -208,7 +209,8 @@ def plot_poincare(
     if ax is None:
         fig, ax = plt.subplots(figsize=(6.5, 5.5))
     else:
-        fig = ax.figure
+        parent = ax.figure
+        fig = parent if isinstance(parent, Figure) else parent.figure  # a SubFigure's root figure
     if trajectory is not None:
         ax.plot(trajectory[:, 0] * s1, trajectory[:, 1] * s2, lw=0.3, color="0.7", label="trajectory")
     sc = ax.scatter(

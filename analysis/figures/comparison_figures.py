@@ -9,7 +9,7 @@ Poincaré panels reuse `figures.plot_poincare`.
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -59,7 +59,9 @@ class TrendPanel:
     logy: bool = False
 
 
-def _panel_row(n: int, width: float, height: float, draw, title: str, path: str | Path | None) -> plt.Figure:
+def _panel_row(
+    n: int, width: float, height: float, draw: Callable[[plt.Axes, int], None], title: str, path: str | Path | None
+) -> plt.Figure:
     """A row of ``n`` panels; ``draw(ax, k)`` fills panel k."""
     fig, axes = plt.subplots(1, n, figsize=(width * n, height), squeeze=False)
     for k, ax in enumerate(axes[0]):
@@ -199,15 +201,16 @@ def plot_orbit_phase_panels(
     Raises:
         ValueError: a panel without a period.
     """
-    if any(p.period is None or not p.period > 0 for p in panels):
+    periods = [p.period for p in panels if p.period is not None and p.period > 0]
+    if len(periods) < len(panels):
         raise ValueError("every OrbitPanel needs a period > 0 s for plot_orbit_phase_panels")
 
     def draw(ax: plt.Axes, k: int) -> None:
-        p = panels[k]
+        p, period = panels[k], periods[k]
         r, jr = p.result, p.result.joints[p.joint]
-        phase = np.mod(r.times, p.period) / p.period * 360.0
+        phase = np.mod(r.times, period) / period * 360.0
         angle = np.degrees(np.arctan2(jr.eccentricity[:, 1], jr.eccentricity[:, 0]))
-        cycle = np.floor(r.times / p.period + 1e-9)
+        cycle = np.floor(r.times / period + 1e-9)
         free = jr.penetration <= 0
         sc = ax.scatter(phase[~free], angle[~free], c=cycle[~free], s=1.5, cmap="viridis", lw=0)
         if free.any():

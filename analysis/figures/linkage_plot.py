@@ -11,12 +11,15 @@ are drawn as thin lines.
 from __future__ import annotations
 
 import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from clearance.kinematics import assemble, link_point_world, solve_kinematics
 from clearance.model import JointType, Mechanism
+
+if TYPE_CHECKING:
+    from matplotlib.axes import Axes
 
 __all__ = ["plot_linkage"]
 
@@ -38,14 +41,14 @@ def plot_linkage(
     mechanism: Mechanism,
     q: np.ndarray | None = None,
     *,
-    ax: Any = None,
+    ax: Axes | None = None,
     t: float = 0.0,
     trace: bool = True,
     trace_points: int = 181,
     title: str | None = None,
     link_names: bool = True,
     joint_names: bool = True,
-) -> Any:
+) -> Axes:
     """Draw a mechanism at a pose with its link and joint names.
 
     Args:
@@ -66,6 +69,7 @@ def plot_linkage(
     """
     import matplotlib.pyplot as plt
     from matplotlib.colors import to_rgba
+    from matplotlib.figure import Figure
     from matplotlib.patches import Polygon, Rectangle
 
     if ax is None:
@@ -188,14 +192,16 @@ def plot_linkage(
             )
         )
     # labels, placed greedily as boxes (size estimated from the font size and the data scale)
-    fig_w, fig_h = ax.figure.get_size_inches()
+    parent = ax.figure
+    fig = parent if isinstance(parent, Figure) else parent.figure  # a SubFigure's root figure
+    fig_w, fig_h = fig.get_size_inches()
     pos = ax.get_position()
     width, height = np.ptp(all_pts, axis=0) + 0.25 * span
     scale = max(width / (fig_w * pos.width), height / (fig_h * pos.height))  # data units per inch
     boxes: list[tuple[np.ndarray, float, float]] = []
     placed: list[np.ndarray] = []
-    samples = [a + f * (b - a) for a, b in segments for f in np.linspace(0.0, 1.0, 12)]
-    samples = np.array(samples) if samples else np.zeros((0, 2))
+    along = [a + f * (b - a) for a, b in segments for f in np.linspace(0.0, 1.0, 12)]
+    samples = np.array(along) if along else np.zeros((0, 2))
     joints_xy = np.array(list(jpos.values())) if jpos else np.zeros((0, 2))
 
     def place(anchor: np.ndarray, text: str, size: float, **kw: Any) -> None:

@@ -28,7 +28,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from clearance.results import SimulationResult
+from clearance.results import JointResult, SimulationResult
 
 __all__ = [
     "ECC_PERCENTILES",
@@ -170,7 +170,7 @@ ECC_PERCENTILES = (10, 50, 90)
 """Percentiles of |e| among the statistics (the shape of the eccentricity distribution)."""
 
 
-def _joint_stats(times: np.ndarray, jr, period: float) -> dict[str, float]:
+def _joint_stats(times: np.ndarray, jr: JointResult, period: float) -> dict[str, float]:
     f, p = jr.force_magnitude, jr.penetration
     contact = p > 0
     e = np.hypot(*jr.eccentricity.T)

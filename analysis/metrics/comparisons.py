@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy import stats
 
+from clearance.model import Mechanism
 from clearance.results import SimulationResult
 
 __all__ = [
@@ -176,7 +177,7 @@ def velocity_zigzag(result: SimulationResult, ideal: SimulationResult, output: s
     return float(np.sum(np.abs(np.diff(v))) / tv0)
 
 
-def joint_distances(mechanism, joints: Sequence[str] | None = None) -> Mapping[str, int]:
+def joint_distances(mechanism: Mechanism, joints: Sequence[str] | None = None) -> Mapping[str, int]:
     """Links between the driven crank and each joint (1: a joint on the crank itself).
 
     Breadth-first over the link graph (ground excluded, so no path runs through the

@@ -168,7 +168,10 @@ def output_peaks(result: SimulationResult, output: str, *, period: float | None 
     for i in np.unique(k):
         idx = np.nonzero(k == i)[0]
         a, b = idx[np.argmax(y[idx])], idx[np.argmin(y[idx])]
-        cmx.append(y[a]), cmxt.append(t[a]), cmn.append(y[b]), cmnt.append(t[b])
+        cmx.append(y[a])
+        cmxt.append(t[a])
+        cmn.append(y[b])
+        cmnt.append(t[b])
     a, b = int(np.argmax(y)), int(np.argmin(y))
     return OutputPeaks(
         float(y[a]),

@@ -229,7 +229,7 @@ def log_run(
 
     # clearance joints
     for jname, jr in res.joints.items():
-        c = mech.joint(jname).clearance.radial_clearance
+        c = mech.joint(jname).require_clearance().radial_clearance
         fmag = jr.force_magnitude
         colors = _force_colors(fmag, float(fmag.max(initial=0.0)))
         base = f"joints/{jname}"

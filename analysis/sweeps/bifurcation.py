@@ -10,14 +10,16 @@ parameters: ``radial_clearance`` [m] or ``crank_speed`` [rad/s].
 from __future__ import annotations
 
 import functools
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from clearance.analysis.sweeps.sweep import SweepEvaluation, run_sweep
+from clearance.analysis.sweeps.sweep import MechanismFactory, SweepEvaluation, run_sweep
+from clearance.options import ModelOptions
 
 __all__ = ["BifurcationDiagram", "bifurcation_from_rows", "run_bifurcation"]
 
@@ -84,8 +86,8 @@ def bifurcation_from_rows(
 
 
 def run_bifurcation(
-    values: Sequence[float],
-    make_mechanism: Callable[[Mapping[str, Any]], Any],
+    values: Sequence[float] | np.ndarray,
+    make_mechanism: MechanismFactory,
     *,
     out_dir: str | Path,
     parameter: str = "radial_clearance",
@@ -93,8 +95,8 @@ def run_bifurcation(
     periods: int = 60,
     sampled: int = 40,
     fixed: Mapping[str, Any] | None = None,
-    options: Any = None,
-    executor: Any = None,
+    options: ModelOptions | None = None,
+    executor: Executor | None = None,
     scheduler_address: str | None = None,
     progress: bool = True,
     stop_after: int | None = None,

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import functools
 from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import Executor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -27,8 +28,9 @@ from typing import Any
 import numpy as np
 from scipy import stats
 
-from clearance.analysis.sweeps.sweep import SweepEvaluation, run_sweep
-from clearance.model import OutputKind
+from clearance.analysis.sweeps.sweep import MechanismFactory, SweepEvaluation, run_sweep
+from clearance.model import Mechanism, OutputKind
+from clearance.options import ModelOptions
 
 __all__ = [
     "CellDeviation",
@@ -44,7 +46,7 @@ __all__ = [
 ]
 
 
-def criticality_candidates(mechanism: Any) -> list[str]:
+def criticality_candidates(mechanism: Mechanism) -> list[str]:
     """Revolute joints eligible for clearance: all but the driven and the output's ground pivot.
 
     Args:
@@ -78,13 +80,13 @@ class ClearanceAtJoint:
             keyword is ``crank2_speed``: see `CatalogueEntry.speed_keyword`).
     """
 
-    builder: Callable[..., Any]
+    builder: Callable[..., Mechanism]
     fixed: Mapping[str, Any] = field(default_factory=dict)
     joint_key: str = "clearance_at"
     clearance_key: str = "radial_clearance"
     speed_key: str = "crank_speed"
 
-    def __call__(self, point: Mapping[str, Any]) -> Any:
+    def __call__(self, point: Mapping[str, Any]) -> Mechanism:
         kw = dict(self.fixed)
         joint = point.get("joint")
         kw[self.joint_key] = () if joint is None else (joint,)
@@ -280,7 +282,7 @@ def ranking_markdown(ranking: CriticalityRanking) -> str:
 
 
 def run_criticality(
-    make_mechanism: Callable[[Mapping[str, Any]], Any],
+    make_mechanism: MechanismFactory,
     *,
     clearances: Sequence[float],
     speeds: Sequence[float],
@@ -288,8 +290,8 @@ def run_criticality(
     joints: Sequence[str] | None = None,
     periods: int = 6,
     output: str | None = None,
-    options: Any = None,
-    executor: Any = None,
+    options: ModelOptions | None = None,
+    executor: Executor | None = None,
     scheduler_address: str | None = None,
     progress: bool = True,
     stop_after: int | None = None,
@@ -326,7 +328,7 @@ def run_criticality(
     probe = make_mechanism({"joint": None, "clearance": clearances[0], "speed": speeds[0]})
     kinds = {o.name: o.kind for o in probe.outputs}
     measured = output or next(iter(kinds), None)
-    if measured not in kinds:
+    if measured is None or measured not in kinds:
         raise ValueError(
             f"output must be one of the outputs of mechanism '{probe.name}', {list(kinds)} (got {output!r})"
         )

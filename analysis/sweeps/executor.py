@@ -16,7 +16,10 @@ from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
-from typing import Any
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from tqdm import tqdm
 
 __all__ = ["Pool", "Progress", "open_executor"]
 
@@ -75,7 +78,7 @@ class Progress:
     def __init__(
         self, total: int, *, enabled: bool = True, desc: str = "runs", unit: str = "run", initial: int = 0
     ) -> None:
-        self._bar: Any = None
+        self._bar: tqdm | None = None
         if enabled and total:
             from tqdm import tqdm
 

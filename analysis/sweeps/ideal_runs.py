@@ -16,16 +16,22 @@ import time
 from collections import OrderedDict
 from typing import Any
 
+from clearance.model import Mechanism
+from clearance.options import ModelOptions
+from clearance.results import SimulationResult
+
 __all__ = ["IDEAL_RUNS_KEPT", "ideal_run", "forget_ideal_runs"]
 
 IDEAL_RUNS_KEPT = 4
 """Ideal runs kept per process (a grid of up to four drive speeds reuses every one)."""
 
-_RUNS: OrderedDict[str, Any] = OrderedDict()
+_RUNS: OrderedDict[str, SimulationResult] = OrderedDict()
 _LOCK = threading.Lock()
 
 
-def ideal_run(mechanism: Any, duration: float, options: Any, timing: dict[str, Any] | None = None) -> Any:
+def ideal_run(
+    mechanism: Mechanism, duration: float, options: ModelOptions | None, timing: dict[str, Any] | None = None
+) -> SimulationResult:
     """Simulate the mechanism's ideal twin, or return this process's run of the same twin.
 
     Args:

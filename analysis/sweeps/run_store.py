@@ -18,7 +18,7 @@ This module receives mechanism factories (picklable callables point -> `Mechanis
 from __future__ import annotations
 
 import json
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import Executor, as_completed
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
@@ -27,6 +27,9 @@ from typing import Any
 import numpy as np
 
 from clearance.analysis.sweeps.executor import Progress, open_executor
+from clearance.analysis.sweeps.sweep import MechanismFactory
+from clearance.model import Mechanism
+from clearance.options import ModelOptions
 from clearance.results import SimulationResult, atomic_write_text
 
 __all__ = ["RunDigest", "RunSpec", "RunStore", "digest_result", "run_batch"]
@@ -49,10 +52,10 @@ class RunSpec:
     """
 
     name: str
-    make_mechanism: Callable[[Mapping[str, Any]], Any]
+    make_mechanism: MechanismFactory
     point: Mapping[str, Any]
     duration: float
-    options: Any = None
+    options: ModelOptions | None = None
     keep_every: int = 1
     window_start: float | None = None
 
@@ -64,7 +67,7 @@ class RunSpec:
         if not isinstance(self.keep_every, int) or self.keep_every < 1:
             raise ValueError(f"RunSpec.keep_every must be a positive integer (got {self.keep_every!r})")
 
-    def mechanism(self) -> Any:
+    def mechanism(self) -> Mechanism:
         """The `Mechanism` of this run."""
         return self.make_mechanism(self.point)
 
@@ -144,7 +147,7 @@ def digest_result(name: str, result: SimulationResult, window_start: float) -> R
     )
 
 
-def _window_start(spec: RunSpec, mechanism: Any) -> float:
+def _window_start(spec: RunSpec, mechanism: Mechanism) -> float:
     if spec.window_start is not None:
         return float(spec.window_start)
     for d in mechanism.drives:

@@ -31,16 +31,39 @@ from collections.abc import Callable, Iterator, Mapping, Sequence
 from concurrent.futures import FIRST_COMPLETED, Executor, Future, wait
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
 from clearance.analysis.sweeps.executor import Pool, Progress, open_executor
 from clearance.analysis.sweeps.ideal_runs import ideal_run
 from clearance.model import Mechanism
-from clearance.results import atomic_write_text
+from clearance.options import ModelOptions
+from clearance.results import SimulationResult, atomic_write_text
 
-__all__ = ["KeywordFactory", "SweepEvaluation", "SweepOutcome", "evaluate_point", "load_rows", "run_sweep"]
+if TYPE_CHECKING:
+    from clearance.analysis.metrics.summary import JointSummary
+
+__all__ = [
+    "Duration",
+    "Evaluation",
+    "KeywordFactory",
+    "MechanismFactory",
+    "SweepEvaluation",
+    "SweepOutcome",
+    "evaluate_point",
+    "load_rows",
+    "run_sweep",
+]
+
+MechanismFactory = Callable[[Mapping[str, Any]], Mechanism]
+"""Picklable point (JSON-like parameters) -> `Mechanism`, as every sweep and batch takes it."""
+
+Duration = float | Callable[[Mechanism], float] | None
+"""Simulated time [s], a picklable mechanism -> time [s], or None (3 drive periods)."""
+
+Evaluation = Callable[[SimulationResult, SimulationResult | None, Mechanism], dict[str, Any]]
+"""Picklable (result, ideal twin's result or None, mechanism) -> row fields."""
 
 
 @dataclass(frozen=True)
@@ -54,11 +77,11 @@ class KeywordFactory:
             builder's (e.g. ``{"clearance": "radial_clearance"}``).
     """
 
-    builder: Callable[..., Any]
+    builder: Callable[..., Mechanism]
     fixed: Mapping[str, Any] = field(default_factory=dict)
     rename: Mapping[str, str] = field(default_factory=dict)
 
-    def __call__(self, point: Mapping[str, Any]) -> Any:
+    def __call__(self, point: Mapping[str, Any]) -> Mechanism:
         kw = dict(self.fixed)
         for k, v in point.items():
             kw[self.rename.get(k, k)] = tuple(v) if isinstance(v, list) else v
@@ -85,7 +108,9 @@ class SweepEvaluation:
     skip_periods: float = 1.0
     ideal: bool = True
 
-    def __call__(self, result: Any, ideal: Any, mechanism: Any) -> dict[str, Any]:
+    def __call__(
+        self, result: SimulationResult, ideal: SimulationResult | None, mechanism: Mechanism
+    ) -> dict[str, Any]:
         """Row fields of one run (see the module docstring)."""
         from clearance.analysis.chaos.poincare import run_section
         from clearance.analysis.metrics.statistics import (
@@ -145,7 +170,7 @@ def _drive_period(mechanism: Mechanism) -> float:
     return period
 
 
-def _summary_dict(s: Any) -> dict[str, Any]:
+def _summary_dict(s: JointSummary) -> dict[str, Any]:
     from dataclasses import asdict
 
     d = asdict(s)
@@ -154,12 +179,12 @@ def _summary_dict(s: Any) -> dict[str, Any]:
     return d
 
 
-def _json_safe(obj: Any) -> Any:
+def _json_safe(obj: object) -> Any:
     """Round-trip through JSON so a row read back from disk equals the computed one."""
     return json.loads(json.dumps(obj, default=_json_default))
 
 
-def _json_default(o: Any) -> Any:
+def _json_default(o: object) -> object:
     if isinstance(o, (np.floating, np.integer, np.bool_)):
         return o.item()
     if isinstance(o, np.ndarray):
@@ -172,10 +197,10 @@ def _json_default(o: Any) -> Any:
 def evaluate_point(
     index: int,
     point: Mapping[str, Any],
-    make_mechanism: Callable[[Mapping[str, Any]], Any],
-    duration: float | Callable[[Any], float] | None,
-    options: Any,
-    evaluation: Callable[[Any, Any, Any], dict[str, Any]],
+    make_mechanism: MechanismFactory,
+    duration: Duration,
+    options: ModelOptions | None,
+    evaluation: Evaluation,
     needs_ideal: bool,
 ) -> dict[str, Any]:
     """Simulate one sweep point and return its row (runs in a worker).
@@ -223,7 +248,7 @@ def evaluate_point(
     return row
 
 
-def _flatten(obj: Any, prefix: str, out: dict[str, Any]) -> None:
+def _flatten(obj: object, prefix: str, out: dict[str, Any]) -> None:
     if isinstance(obj, dict):
         for k, v in obj.items():
             _flatten(v, f"{prefix}.{k}" if prefix else str(k), out)
@@ -256,7 +281,7 @@ def load_rows(out_dir: str | Path) -> list[dict[str, Any]]:
     return sorted((json.loads(p.read_text()) for p in files), key=lambda r: r["index"])
 
 
-def _describe(obj: Any) -> str:
+def _describe(obj: object) -> str:
     """A description stable across processes (no memory addresses) for the manifest.
 
     Functions are named by module and qualified name; partials and dataclass instances
@@ -311,16 +336,16 @@ def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str,
 
 def run_sweep(
     points: Sequence[Mapping[str, Any]],
-    make_mechanism: Callable[[Mapping[str, Any]], Any],
+    make_mechanism: MechanismFactory,
     *,
     out_dir: str | Path,
-    duration: float | Callable[[Any], float] | None = None,
-    options: Any = None,
+    duration: Duration = None,
+    options: ModelOptions | None = None,
     executor: Executor | None = None,
     scheduler_address: str | None = None,
     progress: bool = True,
     stop_after: int | None = None,
-    evaluation: Callable[[Any, Any, Any], dict[str, Any]] | None = None,
+    evaluation: Evaluation | None = None,
     max_workers: int | None = None,
 ) -> SweepOutcome:
     """Run (or resume) a sweep; every finished point is written to disk at once.
@@ -413,7 +438,7 @@ def _run_window(
     save: Callable[[int, dict[str, Any]], None],
     stop_after: int | None,
     finished_count: Callable[[], int],
-    args: tuple[Any, ...],
+    args: tuple[MechanismFactory, Duration, ModelOptions | None, Evaluation, bool],
 ) -> None:
     """Keep ``window`` points in flight (twice the slots, so workers never wait) until done or stopped.
 
