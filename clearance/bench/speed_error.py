@@ -38,6 +38,7 @@ from clearance.analysis.metrics.accuracy import (
 )
 from clearance.analysis.sweeps.executor import Progress, open_executor
 from clearance.model import Mechanism
+from clearance.options import ContactMode, GeomType, ModelOptions
 from clearance.results import atomic_write_bytes, atomic_write_text
 
 __all__ = [
@@ -75,16 +76,18 @@ class Setting:
     segment_geom: str = "sphere"
     contact_mode: str = "nominal"
 
-    def options(self) -> Any:
-        """The `ModelOptions` of this setting."""
-        from clearance.options import ModelOptions
+    def options(self) -> ModelOptions:
+        """The `ModelOptions` of this setting.
 
+        Raises:
+            ValueError: a geom type or contact mode that is not a value of its enum.
+        """
         return ModelOptions(
             timestep=self.timestep,
             segments=self.segments,
-            journal_geom=self.journal_geom,
-            segment_geom=self.segment_geom,
-            contact_mode=self.contact_mode,
+            journal_geom=GeomType(self.journal_geom),
+            segment_geom=GeomType(self.segment_geom),
+            contact_mode=ContactMode(self.contact_mode),
         )
 
     @property
@@ -118,7 +121,7 @@ class Scenario:
     """
 
     name: str
-    factory: Callable[[], Any]
+    factory: Callable[[], Mechanism]
     revolutions: float
     timing_revolutions: float
     settings: tuple[Setting, ...]
@@ -154,7 +157,7 @@ def _period(mechanism: Mechanism) -> float:
 
 
 def ideal_output_function(
-    mechanism: Any, duration: float, *, per_period: int = 2000
+    mechanism: Mechanism, duration: float, *, per_period: int = 2000
 ) -> Callable[[np.ndarray], np.ndarray]:
     """Exact ideal position of the mechanism's first output as a function of time.
 
@@ -237,11 +240,11 @@ def accuracy_task(scenario: Scenario, setting: Setting | None, out_dir: str | Pa
             ideal_output=ideal_output_function(mech, duration),
         )
         rec["statistics"] = statistics_as_dict(stats)
-        result.metadata["clearance"] = {j.name: j.clearance.radial_clearance for j in mech.clearance_joints}
+        result.metadata["clearance"] = {j.name: j.require_clearance().radial_clearance for j in mech.clearance_joints}
         rec["distributions"] = distributions(result, skip=scenario.skip_revolutions * period)
         rec["first_impact"] = {j: (asdict(fi) if (fi := first_impact(result, j)) else None) for j in result.joints}
         rec["period"] = period
-        rec["clearance"] = {j.name: j.clearance.radial_clearance for j in mech.clearance_joints}
+        rec["clearance"] = {j.name: j.require_clearance().radial_clearance for j in mech.clearance_joints}
         rec["metadata"] = {
             k: result.metadata.get(k)
             for k in ("segments", "contact", "steps", "wall_time_s", "steps_per_second", "solver")
@@ -253,7 +256,8 @@ def accuracy_task(scenario: Scenario, setting: Setting | None, out_dir: str | Pa
         import io
 
         buf = io.BytesIO()
-        np.savez_compressed(buf, **arrays)
+        # numpy's stubs type **kwds against the allow_pickle keyword (absent before numpy 2.1) too
+        np.savez_compressed(buf, **arrays)  # type: ignore[arg-type]
         atomic_write_bytes(_task_path(out, "accuracy", scenario.name, key).with_suffix(".npz"), buf.getvalue())
     except Exception as err:
         rec["status"], rec["error"] = "error", f"{type(err).__name__}: {err}"
@@ -313,7 +317,8 @@ def _cost(job: tuple[Scenario, Setting | None]) -> float:
     sc, st = job
     if st is None:
         return math.inf
-    return sc.revolutions * _period(sc.factory()) / st.timestep * (10.0 if st.contact_mode == "exact_ln" else 1.0)
+    loop = 10.0 if ContactMode(st.contact_mode) is ContactMode.EXACT_LN else 1.0
+    return sc.revolutions * _period(sc.factory()) / st.timestep * loop
 
 
 def _todo(out: Path, stage: str, scenarios: Sequence[Scenario]) -> list[tuple[Scenario, Setting | None]]:

@@ -22,7 +22,7 @@ from __future__ import annotations
 
 import json
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -241,7 +241,7 @@ def choose_defaults(
     """
     ok = [r for r in rows if r.status == "ok"]
 
-    def fastest(pred) -> SettingRow | None:
+    def fastest(pred: Callable[[SettingRow], bool]) -> SettingRow | None:
         good = [r for r in ok if pred(r)]
         return min(good, key=lambda r: r.cpu_per_rev) if good else None
 
@@ -344,16 +344,16 @@ def speed_error_markdown(
         ("first_impact", "first impact within 1 %"),
         ("both", "both"),
     ):
-        r = d[k]
+        best = d[k]
         lines.append(
             f"- {text}: "
             + (
                 "none of the settings"
-                if r is None
-                else f"{r.label}: {_speed(r.speedup)} faster than the reference"
-                + (f", {_speed(r.speedup_fixed)} than the fixed baseline" if fixed_per_rev else "")
-                + f" (statistics {100 * r.statistics_error:.1f} %, first impact "
-                f"{100 * r.first_impact_error:.1f} %)"
+                if best is None
+                else f"{best.label}: {_speed(best.speedup)} faster than the reference"
+                + (f", {_speed(best.speedup_fixed)} than the fixed baseline" if fixed_per_rev else "")
+                + f" (statistics {100 * best.statistics_error:.1f} %, first impact "
+                f"{100 * best.first_impact_error:.1f} %)"
             )
         )
     return "\n".join(lines) + "\n"

@@ -91,7 +91,7 @@ def main_calibrate(argv: Sequence[str] | None = None) -> int:
             )
             files = calibration_report(
                 result,
-                j.clearance,
+                j.require_clearance(),
                 ring,
                 options,
                 out_dir=args.out,

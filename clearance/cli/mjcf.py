@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-from typing import Any
 
 from clearance.cli.options import (
     add_scenario_args,
@@ -14,7 +13,7 @@ from clearance.cli.options import (
 __all__ = ["add_parser", "command"]
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``mjcf`` to the subcommands ``sub`` (argparse's subparsers action)."""
     m = sub.add_parser("mjcf", help="write the MuJoCo model (MJCF) of a scenario")
     add_scenario_args(m)

@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from clearance.model import Mechanism
-from clearance.options import ModelOptions
+from clearance.options import ContactMode, GeomType, ModelOptions
 from clearance.units import UNITS
 
 __all__ = [
@@ -44,9 +44,9 @@ NUMERICS_FLAGS = {
 }
 """MuJoCo-only options: flag -> argparse destination."""
 
-JOURNAL_GEOMS = ("sphere", "capsule", "cylinder")
-SEGMENT_GEOMS = ("sphere", "capsule", "box", "cylinder")
-CONTACT_MODES = ("nominal", "calibrated", "exact_ln")
+JOURNAL_GEOMS = tuple(g.value for g in GeomType if g is not GeomType.BOX)
+SEGMENT_GEOMS = tuple(g.value for g in GeomType)
+CONTACT_MODES = tuple(m.value for m in ContactMode)
 
 
 _FACTORS = {
@@ -193,7 +193,7 @@ def mechanism_from_args(args: argparse.Namespace) -> Mechanism:
     entry = CATALOGUE[args.mechanism]
     builder, speed = entry.builder, entry.speed_keyword
     accepted = inspect.signature(builder).parameters
-    given = [
+    overrides = [
         (flag, key, value)
         for flag, key, value in (
             ("--clearance-mm", "radial_clearance", None if args.clearance_mm is None else si(args.clearance_mm, "mm")),
@@ -203,13 +203,13 @@ def mechanism_from_args(args: argparse.Namespace) -> Mechanism:
         )
         if value is not None
     ]
-    refused = [flag for flag, key, _ in given if key not in accepted]
+    refused = [flag for flag, key, _ in overrides if key not in accepted]
     if refused:
         raise ValueError(
             f"mechanism '{args.mechanism}' does not take {', '.join(refused)} from the command line; "
             "use a scenario file (--scenario)"
         )
-    kw = {key: value for _, key, value in given}
+    kw = {key: value for _, key, value in overrides}
     return builder(**kw)
 
 
@@ -219,12 +219,13 @@ def options_from_args(args: argparse.Namespace) -> ModelOptions:
     Raises:
         ValueError: a value `ModelOptions` rejects (it names the field).
     """
+    mode = getattr(args, "contact_mode", None)  # None for a command without --contact-mode
     return ModelOptions(
         segments=args.segments,
         timestep=si(args.timestep_us, "us"),
-        journal_geom=args.journal_geom,
-        segment_geom=args.segment_geom,
-        contact_mode=getattr(args, "contact_mode", None) or ModelOptions().contact_mode,
+        journal_geom=GeomType(args.journal_geom),
+        segment_geom=GeomType(args.segment_geom),
+        contact_mode=ContactMode(mode) if mode else ModelOptions().contact_mode,
     )
 
 

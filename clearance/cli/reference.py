@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
 
 from clearance.cli.options import (
     add_scenario_args,
@@ -19,7 +18,7 @@ from clearance.cli.outputs import duration_from_args, write_outputs
 __all__ = ["add_parser", "command"]
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``reference`` to the subcommands ``sub`` (argparse's subparsers action)."""
     f = sub.add_parser("reference", help="run a scenario with the exact-geometry reference solver (slow)")
     add_scenario_args(f, numerics=False)  # MuJoCo numerics are refused (see command)

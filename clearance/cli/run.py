@@ -5,7 +5,6 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import Any
 
 from clearance.cli.options import (
     add_scenario_args,
@@ -18,7 +17,7 @@ from clearance.cli.outputs import duration_from_args, write_outputs
 __all__ = ["add_parser", "command"]
 
 
-def add_parser(sub: Any) -> None:
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``run`` to the subcommands ``sub`` (argparse's subparsers action)."""
     r = sub.add_parser("run", help="simulate a scenario and write results, figures and the model")
     add_scenario_args(r)

@@ -78,7 +78,7 @@ def main_sweep(argv: Sequence[str] | None = None) -> int:
 
     args = sweep_parser().parse_args(argv)
     entry = catalogue_entry(args.mechanism)
-    fixed = {} if args.clearance_at is None else {"clearance_at": tuple(args.clearance_at)}
+    fixed: dict[str, object] = {} if args.clearance_at is None else {"clearance_at": tuple(args.clearance_at)}
     if args.parameter == "clearance":
         lo, hi, key = si(args.start or 0.01, "mm"), si(args.stop or 1.0, "mm"), "radial_clearance"
         fixed[entry.speed_keyword] = entry.speed_range[1] if args.rpm is None else si(args.rpm, "rpm")

@@ -7,12 +7,15 @@ an argument its builder rejects is a usage error (exit 2), not a sweep of error 
 from __future__ import annotations
 
 import sys
-from collections.abc import Callable
+from collections.abc import Mapping
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from clearance.builders.catalogue import CatalogueEntry
 from clearance.model import Mechanism
+
+if TYPE_CHECKING:  # the analysis is imported by the commands that sweep, when they run
+    from clearance.analysis.sweeps.sweep import MechanismFactory
 
 __all__ = ["UsageError", "catalogue_entry", "probe", "quantities", "report_failures", "usage_error"]
 
@@ -39,7 +42,7 @@ class UsageError(Exception):
     """A command-line argument the mechanism's builder rejects."""
 
 
-def probe(make: Callable[[dict[str, Any]], Mechanism], point: dict[str, Any], mechanism: str) -> Mechanism:
+def probe(make: MechanismFactory, point: Mapping[str, Any], mechanism: str) -> Mechanism:
     """Build the mechanism of one point up front, so a wrong argument is a usage error, not N error rows.
 
     Args:
