@@ -6,7 +6,7 @@ Importing this package is cheap: MuJoCo-dependent parts (`simulate`, `Simulation
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from clearance.model import (
     STEEL,
@@ -24,6 +24,14 @@ from clearance.model import (
     OutputKind,
 )
 from clearance.version import __version__ as __version__
+
+if TYPE_CHECKING:  # for type checkers; at run time `__getattr__` imports these on first use
+    from clearance.options import ContactMode as ContactMode
+    from clearance.options import GeomType as GeomType
+    from clearance.options import ModelOptions as ModelOptions
+    from clearance.results import SimulationResult as SimulationResult
+    from clearance.run.simulation import SimulationError as SimulationError
+    from clearance.run.simulation import simulate as simulate
 
 _LAZY = {
     "simulate": "clearance.run.simulation",
