@@ -2,10 +2,13 @@
 
 `CATALOGUE` maps each mechanism name to its builder and its `LinkageInfo` (topology,
 clearable joints, joints of a criticality ranking, transmission angles, provenance);
-`load_scenario` / `dump_scenario` read and write TOML scenario files. This package never
-imports MuJoCo.
+`load_scenario` / `dump_scenario` read and write TOML scenario files. Every builder ends
+with the same keywords (`ContactKeywords`: where the clearances are, their contact
+properties, gravity, name), spelled out in its signature. This package never imports
+MuJoCo.
 """
 
+from clearance.builders._contact import ContactKeywords
 from clearance.builders.catalogue import (
     CATALOGUE,
     CatalogueEntry,
@@ -53,4 +56,5 @@ __all__ = [
     "load_scenario",
     "dump_scenario",
     "ScenarioError",
+    "ContactKeywords",
 ]

@@ -1,4 +1,4 @@
-"""Shared parts of the catalogue builders: geometry, link mass properties, clearances.
+"""Shared parts of the catalogue builders: geometry, link mass properties, the finished mechanism.
 
 Links of the catalogue are steel bars: every link is a set of straight bars between its
 named points (a binary link is one bar, a ternary plate is a triangle of three bars), with
@@ -17,41 +17,43 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from clearance import checks
-from clearance.kinematics import TransmissionAngle, assemble
+from clearance.builders._contact import ClearanceFactory
+from clearance.kinematics import TransmissionAngle, assemble, solve_kinematics
 from clearance.model import (
-    Clearance,
-    ContactLaw,
+    Drive,
+    DriveKind,
     Joint,
-    JointType,
     Link,
-    Material,
     Mechanism,
+    Output,
 )
 
 __all__ = [
     "DEFAULT_LINEAR_DENSITY",
-    "DEFAULT_RADIAL_CLEARANCE",
     "LinkageInfo",
     "Point",
     "polar",
+    "angle_of",
+    "frame_point",
     "circle_circle",
     "line_circle",
     "bar_link",
     "slider_link",
-    "ClearanceFactory",
     "finish",
+    "make_mechanism",
+    "crank_mechanism",
     "advance",
     "positive",
+    "lengths",
 ]
 
 Point = tuple[float, float]
 
 DEFAULT_LINEAR_DENSITY = 1.57
 """Linear density of the catalogue's bars [kg/m]: steel (7850 kg/m^3), 20 mm x 10 mm."""
-
-DEFAULT_RADIAL_CLEARANCE = 0.1e-3
-"""Default radial clearance of the catalogue's mechanisms [m] (mid-range of 0.02-1 mm)."""
 
 
 @dataclass(frozen=True)
@@ -83,9 +85,28 @@ def positive(name: str, value: float, unit: str = "m") -> float:
     return checks.positive(name, value, unit)
 
 
+def lengths(**values: float) -> dict[str, Any]:
+    """The builder arguments ``values`` checked as lengths (finite, > 0) [m], as floats by name."""
+    return {name: positive(name, value) for name, value in values.items()}
+
+
 def polar(origin: Point, length: float, angle: float) -> Point:
     """origin + length (cos angle, sin angle) [m]."""
     return (origin[0] + length * math.cos(angle), origin[1] + length * math.sin(angle))
+
+
+def angle_of(p: Point, q: Point) -> float:
+    """Angle of the line p -> q from +x [rad]."""
+    return math.atan2(q[1] - p[1], q[0] - p[0])
+
+
+def frame_point(origin: Point, angle: float, local: Point) -> Point:
+    """World position [m] of the point ``local`` of a frame at ``origin`` turned by ``angle`` [rad]."""
+    u, v = local
+    return (
+        origin[0] + u * math.cos(angle) - v * math.sin(angle),
+        origin[1] + u * math.sin(angle) + v * math.cos(angle),
+    )
 
 
 def circle_circle(p1: Point, r1: float, p2: Point, r2: float, *, left: bool, what: str) -> Point:
@@ -188,74 +209,17 @@ def slider_link(name: str, world: Mapping[str, Point], *, mass: float, inertia: 
     return Link(name, mass, inertia, points=_local(world, x0, y0, theta), pose_guess=(x0, y0, theta))
 
 
-class ClearanceFactory:
-    """Turns the builders' common clearance arguments into `Clearance` records by joint name.
+def _posed(mechanism: Mechanism, q: np.ndarray) -> Mechanism:
+    """The mechanism with every moving link's ``pose_guess`` read from the coordinates ``q``."""
+    names = [m.name for m in mechanism.moving_links]
 
-    Args:
-        clearance_at: joints with clearance.
-        clearable: joints that may carry one (the others are driven or prismatic).
-        radial_clearance, bearing_radius: c and R_B [m].
-        restitution, friction, law, material: contact properties of every clearance joint.
+    def pose(lk: Link) -> Link:
+        if lk.name == mechanism.ground:
+            return lk
+        i = 3 * names.index(lk.name)
+        return dataclasses.replace(lk, pose_guess=(float(q[i]), float(q[i + 1]), float(q[i + 2])))
 
-    Raises:
-        ValueError: an unknown or non-clearable joint in ``clearance_at``, or a bad value.
-    """
-
-    def __init__(
-        self,
-        clearance_at: Sequence[str],
-        clearable: Sequence[str],
-        *,
-        radial_clearance: float,
-        bearing_radius: float,
-        restitution: float,
-        friction: float,
-        law: ContactLaw,
-        material: Material,
-    ) -> None:
-        if isinstance(clearance_at, str):
-            raise ValueError(f"clearance_at must be a sequence of joint names (got the string {clearance_at!r})")
-        self.joints = tuple(clearance_at)
-        unknown = [j for j in self.joints if j not in clearable]
-        if unknown:
-            raise ValueError(f"clearance_at: unknown joint(s) {unknown}; expected any of {list(clearable)}")
-        if not isinstance(law, ContactLaw):
-            raise ValueError(f"law must be a ContactLaw (got {law!r})")
-        if not isinstance(material, Material):
-            raise ValueError(f"material must be a Material (got {material!r})")
-        self.template = Clearance(
-            radial_clearance=radial_clearance,
-            bearing_radius=bearing_radius,
-            bearing_material=material,
-            journal_material=material,
-            restitution=restitution,
-            friction=friction,
-            law=law,
-        )
-
-    def __call__(self, joint: str) -> Clearance | None:
-        """The clearance of ``joint``, or None for an ideal joint."""
-        return self.template if joint in self.joints else None
-
-    def revolute(self, name: str, link_a: str, point_a: str, link_b: str, point_b: str) -> Joint:
-        """A revolute joint, with clearance when ``name`` is in ``clearance_at``."""
-        return Joint(name, JointType.REVOLUTE, link_a, point_a, link_b, point_b, clearance=self(name))
-
-    def parameters(self) -> dict[str, Any]:
-        """The common clearance arguments as JSON-friendly builder parameters."""
-        c = self.template
-        return {
-            "clearance_at": list(self.joints),
-            "radial_clearance": c.radial_clearance,
-            "bearing_radius": c.bearing_radius,
-            "restitution": c.restitution,
-            "friction": c.friction,
-            "law": c.law.value,
-            "material": {
-                "youngs_modulus": c.bearing_material.youngs_modulus,
-                "poisson_ratio": c.bearing_material.poisson_ratio,
-            },
-        }
+    return dataclasses.replace(mechanism, links=tuple(pose(lk) for lk in mechanism.links))
 
 
 def finish(mechanism: Mechanism) -> Mechanism:
@@ -265,14 +229,70 @@ def finish(mechanism: Mechanism) -> Mechanism:
         AssemblyError: the loops cannot be closed at the start angles, or the start
             position is singular.
     """
-    q = assemble(mechanism)
-    links = []
-    for lk in mechanism.links:
-        if lk.name != mechanism.ground:
-            i = [m.name for m in mechanism.moving_links].index(lk.name)
-            lk = dataclasses.replace(lk, pose_guess=tuple(float(v) for v in q[3 * i : 3 * i + 3]))
-        links.append(lk)
-    return dataclasses.replace(mechanism, links=tuple(links))
+    return _posed(mechanism, assemble(mechanism))
+
+
+def make_mechanism(
+    clr: ClearanceFactory,
+    links: Sequence[Link],
+    joints: Sequence[Joint],
+    drives: Sequence[Drive],
+    outputs: Sequence[Output],
+    parameters: Mapping[str, Any],
+) -> Mechanism:
+    """The `finish`-ed mechanism of a builder call, with the call's name and gravity (``clr``).
+
+    Raises:
+        ValueError: the parts do not make a valid `Mechanism`.
+        AssemblyError: see `finish`.
+    """
+    return finish(
+        Mechanism(
+            name=clr.name,
+            links=tuple(links),
+            joints=tuple(joints),
+            drives=tuple(drives),
+            outputs=tuple(outputs),
+            gravity=(0.0, -clr.gravity),
+            parameters=parameters,
+        )
+    )
+
+
+def crank_mechanism(
+    clr: ClearanceFactory,
+    links: Sequence[Link],
+    joints: Sequence[Joint],
+    output: Output,
+    dimensions: Mapping[str, Any],
+    *,
+    linear_density: float,
+    crank_speed: float,
+    start_angle: float,
+) -> Mechanism:
+    """The mechanism of a builder whose one drive is a constant-speed crank on joint ``O2``.
+
+    Args:
+        clr: the call's contact keywords.
+        links, joints: the mechanism's links and joints.
+        output: its one output.
+        dimensions: the builder's own parameters (JSON-friendly), first in ``parameters``.
+        linear_density: mass per length of the bars [kg/m].
+        crank_speed: constant crank speed [rad/s].
+        start_angle: crank angle at t = 0 [rad].
+
+    Raises:
+        ValueError, AssemblyError: see `make_mechanism`.
+    """
+    parameters = {
+        **dimensions,
+        "linear_density": linear_density,
+        "crank_speed": float(crank_speed),
+        "start_angle": float(start_angle),
+        **clr.parameters(),
+    }
+    drive = Drive("crank", "O2", speed=crank_speed, start_angle=start_angle)
+    return make_mechanism(clr, links, joints, (drive,), (output,), parameters)
 
 
 def advance(mechanism: Mechanism, start_angle: float) -> Mechanism:
@@ -284,9 +304,6 @@ def advance(mechanism: Mechanism, start_angle: float) -> Mechanism:
     Raises:
         SingularPositionError: a dead point lies between 0 and ``start_angle``.
     """
-    from clearance.kinematics import solve_kinematics
-    from clearance.model import DriveKind
-
     (drive,) = mechanism.drives
     if start_angle == 0:
         return mechanism
@@ -298,14 +315,5 @@ def advance(mechanism: Mechanism, start_angle: float) -> Mechanism:
             ),
         ),
     )
-    q = solve_kinematics(probe, [0.0, abs(start_angle)]).q[-1]
-    names = [m.name for m in mechanism.moving_links]
-    links = tuple(
-        lk
-        if lk.name == mechanism.ground
-        else dataclasses.replace(
-            lk, pose_guess=tuple(float(v) for v in q[3 * names.index(lk.name) : 3 * names.index(lk.name) + 3])
-        )
-        for lk in mechanism.links
-    )
-    return dataclasses.replace(mechanism, links=links, drives=(dataclasses.replace(drive, start_angle=start_angle),))
+    q = solve_kinematics(probe, np.array([0.0, abs(start_angle)])).q[-1]
+    return dataclasses.replace(_posed(mechanism, q), drives=(dataclasses.replace(drive, start_angle=start_angle),))

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import re
 from collections.abc import Sequence
-from typing import Any
+from typing import Any, Literal, TypeVar, overload
 
 from clearance.units import UNITS, describe_units
 
@@ -32,6 +32,8 @@ class ScenarioError(ValueError):
         self.path, self.key, self.line = path, key, line
 
 
+_T = TypeVar("_T")
+
 _HEADER = re.compile(r"^\s*(\[\[?)\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
 
 
@@ -47,15 +49,19 @@ class Locator:
         """1-based line of ``loc`` = (table, [index], [subtable...], key), or None."""
         start, end, prefix = 0, len(self.lines), ""
         parts = list(loc)
-        key = parts.pop() if parts and isinstance(parts[-1], str) else None
+        key = None
+        if parts and isinstance(last := parts[-1], str):
+            key = last
+            parts.pop()
         i = 0
         while i < len(parts):
             name = f"{prefix}.{parts[i]}" if prefix else str(parts[i])
-            if i + 1 < len(parts) and isinstance(parts[i + 1], int):
+            index = parts[i + 1] if i + 1 < len(parts) else None
+            if isinstance(index, int):
                 hits = [h for h, n in self.headers if n == name and start <= h < end]
-                if len(hits) <= parts[i + 1]:
+                if len(hits) <= index:
                     return None
-                start = hits[parts[i + 1]]
+                start = hits[index]
                 i += 2
             else:
                 hits = [h for h, n in self.headers if n == name and start <= h < end]
@@ -87,7 +93,7 @@ class Table:
         locator: line finder.
     """
 
-    def __init__(self, data: Any, loc: tuple, label: str, locator: Locator) -> None:
+    def __init__(self, data: Any, loc: tuple[str | int, ...], label: str, locator: Locator) -> None:
         self.loc, self.label, self.locator = loc, label, locator
         if not isinstance(data, dict):
             raise self.error(None, f"must be a table (got {type(data).__name__})")
@@ -112,14 +118,17 @@ class Table:
             return self.data[key]
         return default
 
+    def _default(self, default: _T | None, missing: str) -> _T:
+        """``default`` for an absent key, which is required without one (``missing`` names it)."""
+        if default is None:
+            raise self.error(None, f"missing key {missing}")
+        return default
+
     def text(self, key: str, *, default: str | None = None, choices: Sequence[str] | None = None) -> str:
         """A string value; required unless ``default`` is given."""
         if key not in self.data:
-            if default is None:
-                raise self.error(None, f"missing key '{key}'")
-            return default
-        self.used.add(key)
-        v = self.data[key]
+            return self._default(default, f"'{key}'")
+        v = self.raw(key)
         if not isinstance(v, str):
             raise self.error(key, f"must be a string (got {v!r})")
         if choices is not None and v not in choices:
@@ -129,16 +138,14 @@ class Table:
     def plain(self, key: str, default: float | None = None) -> float:
         """A number without unit (restitution, friction, Poisson's ratio)."""
         if key not in self.data:
-            if default is None:
-                raise self.error(None, f"missing key '{key}'")
-            return default
-        self.used.add(key)
-        v = self.data[key]
+            return self._default(default, f"'{key}'")
+        v = self.raw(key)
         if not _is_number(v):
             raise self.error(key, f"must be a number (got {v!r})")
         return v
 
-    def _unit_key(self, base: str, quantity: str, required: bool) -> tuple[str, float] | None:
+    def _unit_key(self, base: str, quantity: str) -> tuple[str, float] | None:
+        """(key, factor to SI) of the one key ``<base>_<unit>``; None when there is none."""
         units = UNITS[quantity]
         found = [k for k in self.data if k == base or k.startswith(base + "_")]
         if base in found:
@@ -152,17 +159,15 @@ class Table:
         if len(good) > 1:
             raise self.error(good[1], f"{base} is given twice ({', '.join(good)})")
         if not good:
-            if required:
-                raise self.error(None, f"missing key '{base}_<unit>' ({describe_units(base, quantity)})")
             return None
         self.used.add(good[0])
         return good[0], units[good[0][len(base) + 1 :]]
 
     def number(self, base: str, quantity: str, default: float | None = None) -> float:
         """A number with a unit in its key name, converted to SI; required unless defaulted."""
-        hit = self._unit_key(base, quantity, default is None)
+        hit = self._unit_key(base, quantity)
         if hit is None:
-            return default
+            return self._default(default, f"'{base}_<unit>' ({describe_units(base, quantity)})")
         key, factor = hit
         v = self.data[key]
         if not _is_number(v):
@@ -171,9 +176,9 @@ class Table:
 
     def pair(self, base: str, quantity: str, default: tuple[float, float] | None = None) -> tuple[float, float]:
         """An (x, y) pair with a unit in its key name, converted to SI."""
-        hit = self._unit_key(base, quantity, default is None)
+        hit = self._unit_key(base, quantity)
         if hit is None:
-            return default
+            return self._default(default, f"'{base}_<unit>' ({describe_units(base, quantity)})")
         key, factor = hit
         return self.convert_pair(key, self.data[key], factor)
 
@@ -182,6 +187,12 @@ class Table:
         if not (isinstance(v, list) and len(v) == 2 and all(_is_number(x) for x in v)):
             raise self.error(key, f"must be a pair of numbers [x, y] (got {v!r})")
         return tuple(x * factor if factor != 1.0 else x for x in v)
+
+    @overload
+    def sub(self, key: str, label: str, *, required: Literal[True]) -> Table: ...
+
+    @overload
+    def sub(self, key: str, label: str, *, required: bool = False) -> Table | None: ...
 
     def sub(self, key: str, label: str, *, required: bool = False) -> Table | None:
         """The sub-table ``key`` (None when absent and not required)."""

@@ -213,4 +213,5 @@ def check_linkage(mechanism: Mechanism, info: LinkageInfo, *, samples: int = 721
         worst = min(worst, float(np.min(np.minimum(mu, 180.0 - mu))))
     outs = {o.name: (float(kin.outputs[o.name].min()), float(kin.outputs[o.name].max())) for o in mechanism.outputs}
     acc = {o.name: float(np.max(np.abs(kin.outputs[o.name + "_acc"]))) for o in mechanism.outputs}
-    return LinkageCheck(trans, worst, float(np.nanmin(kin.singularity)), outs, acc, period)
+    singular = math.nan if kin.singularity is None else float(np.nanmin(kin.singularity))
+    return LinkageCheck(trans, worst, singular, outs, acc, period)

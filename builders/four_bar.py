@@ -12,31 +12,20 @@ Topology: ground 1, crank 2 (driven, pivot O2), coupler 3, rocker 4 (output, piv
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from typing import Unpack
 
+from clearance.builders._contact import ClearanceFactory, ContactKeywords, contact_keywords
 from clearance.builders._linkage import (
     DEFAULT_LINEAR_DENSITY,
-    DEFAULT_RADIAL_CLEARANCE,
-    ClearanceFactory,
     LinkageInfo,
     bar_link,
-    circle_circle,
-    finish,
-    polar,
+    crank_mechanism,
     positive,
 )
+from clearance.builders._loops import crank_rocker, crank_rocker_joints
 from clearance.builders.slider_crank import rpm
 from clearance.kinematics import TransmissionAngle
-from clearance.model import (
-    STEEL,
-    ContactLaw,
-    Drive,
-    Link,
-    Material,
-    Mechanism,
-    Output,
-    OutputKind,
-)
+from clearance.model import Link, Mechanism, Output, OutputKind
 
 __all__ = ["four_bar", "FOUR_BAR_INFO"]
 
@@ -54,6 +43,7 @@ FOUR_BAR_INFO = LinkageInfo(
 )
 
 
+@contact_keywords(clearance_at=("B",))
 def four_bar(
     *,
     crank_length: float = 0.04,
@@ -63,15 +53,7 @@ def four_bar(
     linear_density: float = DEFAULT_LINEAR_DENSITY,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("B",),
-    radial_clearance: float = DEFAULT_RADIAL_CLEARANCE,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "four_bar",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the crank-rocker four-bar with clearance at the chosen revolute joints.
 
@@ -84,13 +66,9 @@ def four_bar(
         linear_density: mass per length of the steel bars [kg/m].
         crank_speed: constant crank speed [rad/s] (default 1000 rpm).
         start_angle: crank angle at t = 0 [rad] from +x.
-        clearance_at: joints with clearance, any of ``A``, ``B``, ``O4``; empty for none.
-        radial_clearance: c [m] at every clearance joint.
-        bearing_radius: R_B [m].
-        restitution, friction, law: contact properties of every clearance joint.
-        material: journal and bearing material.
-        gravity: gravitational acceleration [m/s^2] along -y (0 for none).
-        name: mechanism name.
+        clearance_at, radial_clearance, bearing_radius, restitution, friction, law,
+            material, gravity, name: the contact keywords (`ContactKeywords`);
+            ``clearance_at`` any of ``A``, ``B``, ``O4``.
 
     Returns:
         The mechanism.
@@ -105,50 +83,17 @@ def four_bar(
     c = positive("rocker_length", rocker_length)
     d = positive("ground_length", ground_length)
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(
-        clearance_at,
-        FOUR_BAR_INFO.clearable,
-        radial_clearance=radial_clearance,
-        bearing_radius=bearing_radius,
-        restitution=restitution,
-        friction=friction,
-        law=law,
-        material=material,
-    )
-    o2, o4 = (0.0, 0.0), (d, 0.0)
-    pa = polar(o2, a, start_angle)
-    pb = circle_circle(pa, b, o4, c, left=True, what="coupler 3 / rocker 4")
+    clr = ClearanceFactory(FOUR_BAR_INFO.clearable, contact)
+    p = crank_rocker(a, b, c, d, start_angle)
     links = (
-        Link("ground", 0.0, 0.0, points={"O2": o2, "O4": o4}),
-        bar_link("crank2", {"O2": o2, "A": pa}, density=lam),
-        bar_link("coupler3", {"A": pa, "B": pb}, density=lam),
-        bar_link("rocker4", {"O4": o4, "B": pb}, density=lam),
+        Link("ground", 0.0, 0.0, points={"O2": p["O2"], "O4": p["O4"]}),
+        bar_link("crank2", {"O2": p["O2"], "A": p["A"]}, density=lam),
+        bar_link("coupler3", {"A": p["A"], "B": p["B"]}, density=lam),
+        bar_link("rocker4", {"O4": p["O4"], "B": p["B"]}, density=lam),
     )
-    joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
-        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-    )
-    params = {
-        "crank_length": a,
-        "coupler_length": b,
-        "rocker_length": c,
-        "ground_length": d,
-        "linear_density": lam,
-        "crank_speed": float(crank_speed),
-        "start_angle": float(start_angle),
-        **clr.parameters(),
-        "gravity": float(gravity),
-    }
-    return finish(
-        Mechanism(
-            name=name,
-            links=links,
-            joints=joints,
-            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-            outputs=(Output("rocker_angle", "rocker4", OutputKind.ANGLE),),
-            gravity=(0.0, -gravity),
-            parameters=params,
-        )
+    joints = crank_rocker_joints(clr)
+    dims = {"crank_length": a, "coupler_length": b, "rocker_length": c, "ground_length": d}
+    output = Output("rocker_angle", "rocker4", OutputKind.ANGLE)
+    return crank_mechanism(
+        clr, links, joints, output, dims, linear_density=lam, crank_speed=crank_speed, start_angle=start_angle
     )

@@ -19,43 +19,35 @@ from 0 and 180 deg over the whole revolution (docs/catalogue/catalogue.md lists 
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Any, Unpack
 
+from clearance.builders._contact import ClearanceFactory, ContactKeywords, contact_keywords
 from clearance.builders._linkage import (
     DEFAULT_LINEAR_DENSITY as _LAM,
 )
 from clearance.builders._linkage import (
-    DEFAULT_RADIAL_CLEARANCE as _C,
-)
-from clearance.builders._linkage import (
-    ClearanceFactory,
     LinkageInfo,
+    Point,
+    angle_of,
     bar_link,
     circle_circle,
-    finish,
+    crank_mechanism,
+    frame_point,
+    lengths,
     line_circle,
     polar,
     positive,
     slider_link,
 )
+from clearance.builders._loops import coupler_bars, coupler_point, crank_rocker, crank_rocker_joints
 from clearance.builders.slider_crank import rpm
 from clearance.kinematics import TransmissionAngle as _T
-from clearance.model import (
-    STEEL,
-    ContactLaw,
-    Drive,
-    Joint,
-    JointType,
-    Link,
-    Material,
-    Mechanism,
-    Output,
-    OutputKind,
-)
+from clearance.model import Joint, JointType, Link, Mechanism, Output, OutputKind
 
 __all__ = ["eight_bar", "ten_bar", "EIGHT_BAR_INFO", "TEN_BAR_INFO"]
 
-_LN = ContactLaw.LANKARANI_NIKRAVESH
 _OWN = "project's own topology and dimensions (grid search for the best transmission angles)"
 
 EIGHT_BAR_INFO = LinkageInfo(
@@ -91,22 +83,112 @@ TEN_BAR_INFO = LinkageInfo(
 )
 
 
-def _four_bar(
-    crank: float, coupler: float, rocker: float, ground: float, point: tuple[float, float], th: float
-) -> dict[str, tuple[float, float]]:
-    o2, o4 = (0.0, 0.0), (ground, 0.0)
-    pa = polar(o2, crank, th)
-    pb = circle_circle(pa, coupler, o4, rocker, left=True, what="coupler 3 / rocker 4")
-    t3 = math.atan2(pb[1] - pa[1], pb[0] - pa[0])
-    u, v = point
-    pc = (pa[0] + u * math.cos(t3) - v * math.sin(t3), pa[1] + u * math.sin(t3) + v * math.cos(t3))
-    return {"O2": o2, "O4": o4, "A": pa, "B": pb, "C": pc}
+@dataclass(frozen=True)
+class _Opening:
+    """What the eight- and ten-bar builders open with.
+
+    Attributes:
+        dims: the checked lengths by keyword [m] (the first builder parameters).
+        clr: the call's contact keywords.
+        points: O2, O4, A, B, C of the four-bar and the pivot O6, at t = 0 [m].
+        coupler3_point: C in the coupler frame [m].
+        slider_mass, slider_inertia, linear_density: checked [kg, kg m^2, kg/m].
+    """
+
+    dims: dict[str, Any]
+    clr: ClearanceFactory
+    points: dict[str, Point]
+    coupler3_point: Point
+    slider_mass: float
+    slider_inertia: float
+    linear_density: float
 
 
-def _angle(p: tuple[float, float], q: tuple[float, float]) -> float:
-    return math.atan2(q[1] - p[1], q[0] - p[0])
+def _open(
+    info: LinkageInfo,
+    contact: ContactKeywords,
+    dims: dict[str, Any],
+    *,
+    coupler3_point: tuple[float, float],
+    rocker6_pivot: tuple[float, float],
+    slider_mass: float,
+    slider_inertia: float,
+    linear_density: float,
+    start_angle: float,
+) -> _Opening:
+    """Check the other common arguments and assemble the four-bar with coupler point C at t = 0.
+
+    Args:
+        info: the builder's linkage.
+        contact: the call's contact keywords.
+        dims: the builder's checked lengths (`lengths`) [m].
+        coupler3_point, rocker6_pivot, slider_mass, slider_inertia, linear_density,
+            start_angle: the builder's arguments.
+
+    Raises:
+        ValueError: a value out of range, an unknown clearance joint, or a four-bar that
+            does not close at the start angle.
+    """
+    ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
+    lam = positive("linear_density", linear_density, "kg/m")
+    clr = ClearanceFactory(info.clearable, contact)
+    cp = (float(coupler3_point[0]), float(coupler3_point[1]))
+    p = crank_rocker(
+        dims["crank_length"], dims["coupler3_length"], dims["rocker4_length"], dims["ground_length"], start_angle
+    )
+    p["C"] = coupler_point(p, cp)
+    p["O6"] = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
+    return _Opening(dims, clr, p, cp, ms, js, lam)
 
 
+def _four_bar_joints(clr: ClearanceFactory) -> tuple[Joint, ...]:
+    """The joints of the four-bar (O2, A, B, O4) and of coupler point C to link 5."""
+    return (*crank_rocker_joints(clr), clr.pin("C", "coupler3", "link5"))
+
+
+def _close(
+    o: _Opening,
+    links: Sequence[Link],
+    joints: Sequence[Joint],
+    own: Mapping[str, Any],
+    guide_height: float,
+    slider: str,
+    pin: str,
+    crank_speed: float,
+    start_angle: float,
+) -> Mechanism:
+    """The mechanism, whose output is the x position of ``pin`` of link ``slider`` [m].
+
+    Args:
+        o: the opening.
+        links, joints: the mechanism's.
+        own: the builder's parameters between ``coupler3_point`` and ``guide_height``.
+        guide_height: y of the horizontal guide [m].
+        slider, pin: the output slider and its pin.
+        crank_speed, start_angle: of the crank [rad/s, rad].
+    """
+    dims = {
+        **o.dims,
+        "coupler3_point": list(o.coupler3_point),
+        **own,
+        "guide_height": float(guide_height),
+        "slider_mass": o.slider_mass,
+        "slider_inertia": o.slider_inertia,
+    }
+    output = Output("slider_x", slider, OutputKind.POSITION_X, point=pin)
+    return crank_mechanism(
+        o.clr,
+        links,
+        joints,
+        output,
+        dims,
+        linear_density=o.linear_density,
+        crank_speed=crank_speed,
+        start_angle=start_angle,
+    )
+
+
+@contact_keywords(clearance_at=("D",))
 def eight_bar(
     *,
     crank_length: float = 0.04,
@@ -126,15 +208,7 @@ def eight_bar(
     linear_density: float = _LAM,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("D",),
-    radial_clearance: float = _C,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = _LN,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "eight_bar",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the eight-bar: Stephenson II (1) plus rod 7 and an output slider.
 
@@ -150,47 +224,39 @@ def eight_bar(
         linear_density: mass per length of the steel bars [kg/m].
         crank_speed: constant crank speed [rad/s] (default 1000 rpm).
         start_angle: crank angle at t = 0 [rad] from +x.
-        clearance_at: joints with clearance (see `EIGHT_BAR_INFO.clearable`).
-        radial_clearance, bearing_radius: c and R_B [m].
-        restitution, friction, law, material: contact properties of every clearance joint.
-        gravity: gravitational acceleration [m/s^2] along -y (0 for none).
-        name: mechanism name.
+        clearance_at, radial_clearance, bearing_radius, restitution, friction, law,
+            material, gravity, name: the contact keywords (`ContactKeywords`);
+            ``clearance_at`` any of `EIGHT_BAR_INFO.clearable`.
 
     Raises:
         ValueError: a value out of range, an unknown clearance joint, or lengths that do
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {
-        k: positive(k, v)
-        for k, v in (
-            ("crank_length", crank_length),
-            ("coupler3_length", coupler3_length),
-            ("rocker4_length", rocker4_length),
-            ("ground_length", ground_length),
-            ("link5_length", link5_length),
-            ("rocker6_length", rocker6_length),
-            ("rocker6_arm", rocker6_arm),
-            ("rod7_length", rod7_length),
-        )
-    }
-    ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
-    lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(
-        clearance_at,
-        EIGHT_BAR_INFO.clearable,
-        radial_clearance=radial_clearance,
-        bearing_radius=bearing_radius,
-        restitution=restitution,
-        friction=friction,
-        law=law,
-        material=material,
+    o = _open(
+        EIGHT_BAR_INFO,
+        contact,
+        lengths(
+            crank_length=crank_length,
+            coupler3_length=coupler3_length,
+            rocker4_length=rocker4_length,
+            ground_length=ground_length,
+            link5_length=link5_length,
+            rocker6_length=rocker6_length,
+            rocker6_arm=rocker6_arm,
+            rod7_length=rod7_length,
+        ),
+        coupler3_point=coupler3_point,
+        rocker6_pivot=rocker6_pivot,
+        slider_mass=slider_mass,
+        slider_inertia=slider_inertia,
+        linear_density=linear_density,
+        start_angle=start_angle,
     )
-    cp = (float(coupler3_point[0]), float(coupler3_point[1]))
-    p = _four_bar(crank_length, coupler3_length, rocker4_length, ground_length, cp, start_angle)
-    o6 = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
+    p, cp, lam, clr = o.points, o.coupler3_point, o.linear_density, o.clr
+    o6 = p["O6"]
     pd = circle_circle(p["C"], link5_length, o6, rocker6_length, left=True, what="link 5 / rocker 6")
-    pe = polar(o6, rocker6_arm, _angle(o6, pd) + rocker6_arm_angle)
+    pe = polar(o6, rocker6_arm, angle_of(o6, pd) + rocker6_arm_angle)
     g8 = (o6[0], float(guide_height))
     pf = line_circle(g8, (1.0, 0.0), pe, rod7_length, forward=True, what="rod 7 / slider 8")
     links = (
@@ -200,52 +266,27 @@ def eight_bar(
             "coupler3",
             {"A": p["A"], "B": p["B"], "C": p["C"]},
             density=lam,
-            bars=[("A", "C")] if cp[1] == 0 and cp[0] >= 0 else None,
+            bars=coupler_bars(cp),
         ),
         bar_link("rocker4", {"O4": p["O4"], "B": p["B"]}, density=lam),
         bar_link("link5", {"C": p["C"], "D": pd}, density=lam),
         bar_link("rocker6", {"O6": o6, "D": pd, "E": pe}, density=lam, bars=[("O6", "D"), ("O6", "E")]),
         bar_link("rod7", {"E": pe, "F": pf}, density=lam),
-        slider_link("slider8", {"F": pf}, mass=ms, inertia=js),
+        slider_link("slider8", {"F": pf}, mass=o.slider_mass, inertia=o.slider_inertia),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
-        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("C", "coupler3", "C", "link5", "C"),
-        clr.revolute("D", "link5", "D", "rocker6", "D"),
-        clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
-        clr.revolute("E", "rocker6", "E", "rod7", "E"),
-        clr.revolute("F", "rod7", "F", "slider8", "F"),
+        *_four_bar_joints(clr),
+        clr.pin("D", "link5", "rocker6"),
+        clr.pin("O6", "ground", "rocker6"),
+        clr.pin("E", "rocker6", "rod7"),
+        clr.pin("F", "rod7", "slider8"),
         Joint("P8", JointType.PRISMATIC, "ground", "G8", "slider8", "F", axis=(1.0, 0.0)),
     )
-    dims.update(
-        coupler3_point=list(cp),
-        rocker6_pivot=list(o6),
-        rocker6_arm_angle=float(rocker6_arm_angle),
-        guide_height=float(guide_height),
-        slider_mass=ms,
-        slider_inertia=js,
-        linear_density=lam,
-        crank_speed=float(crank_speed),
-        start_angle=float(start_angle),
-        **clr.parameters(),
-        gravity=float(gravity),
-    )
-    return finish(
-        Mechanism(
-            name=name,
-            links=links,
-            joints=joints,
-            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-            outputs=(Output("slider_x", "slider8", OutputKind.POSITION_X, point="F"),),
-            gravity=(0.0, -gravity),
-            parameters=dims,
-        )
-    )
+    own = {"rocker6_pivot": list(o6), "rocker6_arm_angle": float(rocker6_arm_angle)}
+    return _close(o, links, joints, own, guide_height, "slider8", "F", crank_speed, start_angle)
 
 
+@contact_keywords(clearance_at=("G",))
 def ten_bar(
     *,
     crank_length: float = 0.04,
@@ -270,15 +311,7 @@ def ten_bar(
     linear_density: float = _LAM,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("G",),
-    radial_clearance: float = _C,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = _LN,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "ten_bar",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the ten-bar: four-bar, dyad 5-6 to ground, dyad 7-8 between the rockers, slider.
 
@@ -294,7 +327,7 @@ def ten_bar(
         link8_point: H in the frame of link 8 (origin F, x towards G) [m].
         rod9_length: H-I [m]; guide_height: y of the horizontal guide [m].
         slider_mass: [kg]; slider_inertia: [kg m^2].
-        linear_density, crank_speed, start_angle, clearance_at (see
+        linear_density, crank_speed, start_angle, clearance_at (any of
             `TEN_BAR_INFO.clearable`), radial_clearance, bearing_radius, restitution,
             friction, law, material, gravity, name: as in `eight_bar`.
 
@@ -303,44 +336,37 @@ def ten_bar(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {
-        k: positive(k, v)
-        for k, v in (
-            ("crank_length", crank_length),
-            ("coupler3_length", coupler3_length),
-            ("rocker4_length", rocker4_length),
-            ("ground_length", ground_length),
-            ("rocker4_arm", rocker4_arm),
-            ("link5_length", link5_length),
-            ("rocker6_length", rocker6_length),
-            ("rocker6_arm", rocker6_arm),
-            ("link7_length", link7_length),
-            ("link8_length", link8_length),
-            ("rod9_length", rod9_length),
-        )
-    }
-    ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
-    lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(
-        clearance_at,
-        TEN_BAR_INFO.clearable,
-        radial_clearance=radial_clearance,
-        bearing_radius=bearing_radius,
-        restitution=restitution,
-        friction=friction,
-        law=law,
-        material=material,
+    o = _open(
+        TEN_BAR_INFO,
+        contact,
+        lengths(
+            crank_length=crank_length,
+            coupler3_length=coupler3_length,
+            rocker4_length=rocker4_length,
+            ground_length=ground_length,
+            rocker4_arm=rocker4_arm,
+            link5_length=link5_length,
+            rocker6_length=rocker6_length,
+            rocker6_arm=rocker6_arm,
+            link7_length=link7_length,
+            link8_length=link8_length,
+            rod9_length=rod9_length,
+        ),
+        coupler3_point=coupler3_point,
+        rocker6_pivot=rocker6_pivot,
+        slider_mass=slider_mass,
+        slider_inertia=slider_inertia,
+        linear_density=linear_density,
+        start_angle=start_angle,
     )
-    cp = (float(coupler3_point[0]), float(coupler3_point[1]))
-    p = _four_bar(crank_length, coupler3_length, rocker4_length, ground_length, cp, start_angle)
-    o6 = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
-    pd = polar(p["O4"], rocker4_arm, _angle(p["O4"], p["B"]) + rocker4_arm_angle)
+    p, lam, clr = o.points, o.linear_density, o.clr
+    o6 = p["O6"]
+    pd = polar(p["O4"], rocker4_arm, angle_of(p["O4"], p["B"]) + rocker4_arm_angle)
     pe = circle_circle(p["C"], link5_length, o6, rocker6_length, left=False, what="link 5 / rocker 6")
-    pf = polar(o6, rocker6_arm, _angle(o6, pe) + rocker6_arm_angle)
+    pf = polar(o6, rocker6_arm, angle_of(o6, pe) + rocker6_arm_angle)
     pg = circle_circle(pd, link7_length, pf, link8_length, left=False, what="link 7 / link 8")
-    t8 = _angle(pf, pg)
     hu, hv = float(link8_point[0]), float(link8_point[1])
-    ph = (pf[0] + hu * math.cos(t8) - hv * math.sin(t8), pf[1] + hu * math.sin(t8) + hv * math.cos(t8))
+    ph = frame_point(pf, angle_of(pf, pg), (hu, hv))
     g10 = (o6[0], float(guide_height))
     pi_ = line_circle(g10, (1.0, 0.0), ph, rod9_length, forward=True, what="rod 9 / slider 10")
     links = (
@@ -353,46 +379,23 @@ def ten_bar(
         bar_link("link7", {"D": pd, "G": pg}, density=lam),
         bar_link("link8", {"F": pf, "G": pg, "H": ph}, density=lam),
         bar_link("rod9", {"H": ph, "I": pi_}, density=lam),
-        slider_link("slider10", {"I": pi_}, mass=ms, inertia=js),
+        slider_link("slider10", {"I": pi_}, mass=o.slider_mass, inertia=o.slider_inertia),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
-        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("C", "coupler3", "C", "link5", "C"),
-        clr.revolute("E", "link5", "E", "rocker6", "E"),
-        clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
-        clr.revolute("D", "rocker4", "D", "link7", "D"),
-        clr.revolute("G", "link7", "G", "link8", "G"),
-        clr.revolute("F", "rocker6", "F", "link8", "F"),
-        clr.revolute("H", "link8", "H", "rod9", "H"),
-        clr.revolute("I", "rod9", "I", "slider10", "I"),
+        *_four_bar_joints(clr),
+        clr.pin("E", "link5", "rocker6"),
+        clr.pin("O6", "ground", "rocker6"),
+        clr.pin("D", "rocker4", "link7"),
+        clr.pin("G", "link7", "link8"),
+        clr.pin("F", "rocker6", "link8"),
+        clr.pin("H", "link8", "rod9"),
+        clr.pin("I", "rod9", "slider10"),
         Joint("P10", JointType.PRISMATIC, "ground", "G10", "slider10", "I", axis=(1.0, 0.0)),
     )
-    dims.update(
-        coupler3_point=list(cp),
-        rocker4_arm_angle=float(rocker4_arm_angle),
-        rocker6_pivot=list(o6),
-        rocker6_arm_angle=float(rocker6_arm_angle),
-        link8_point=[hu, hv],
-        guide_height=float(guide_height),
-        slider_mass=ms,
-        slider_inertia=js,
-        linear_density=lam,
-        crank_speed=float(crank_speed),
-        start_angle=float(start_angle),
-        **clr.parameters(),
-        gravity=float(gravity),
-    )
-    return finish(
-        Mechanism(
-            name=name,
-            links=links,
-            joints=joints,
-            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-            outputs=(Output("slider_x", "slider10", OutputKind.POSITION_X, point="I"),),
-            gravity=(0.0, -gravity),
-            parameters=dims,
-        )
-    )
+    own = {
+        "rocker4_arm_angle": float(rocker4_arm_angle),
+        "rocker6_pivot": list(o6),
+        "rocker6_arm_angle": float(rocker6_arm_angle),
+        "link8_point": [hu, hv],
+    }
+    return _close(o, links, joints, own, guide_height, "slider10", "I", crank_speed, start_angle)

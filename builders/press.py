@@ -19,31 +19,29 @@ the servo's default period equals crank 2's (CLARIFICATIONS.md).
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
-from typing import Any
+from typing import Any, Unpack
 
+from clearance.builders._contact import ClearanceFactory, ContactKeywords, contact_keywords
 from clearance.builders._linkage import (
-    DEFAULT_RADIAL_CLEARANCE,
-    ClearanceFactory,
     LinkageInfo,
+    angle_of,
     bar_link,
     circle_circle,
-    finish,
+    frame_point,
+    lengths,
     line_circle,
+    make_mechanism,
     polar,
     positive,
     slider_link,
 )
 from clearance.kinematics import TransmissionAngle
 from clearance.model import (
-    STEEL,
-    ContactLaw,
     Drive,
     DriveKind,
     Joint,
     JointType,
     Link,
-    Material,
     Mechanism,
     MotionLaw,
     Output,
@@ -86,6 +84,7 @@ def _law_params(motion: MotionLaw) -> dict[str, Any]:
     return out
 
 
+@contact_keywords(clearance_at=("A", "C"), gravity=9.81)
 def seven_bar_press(
     *,
     crank2_length: float = 0.08,
@@ -105,15 +104,7 @@ def seven_bar_press(
     crank7_speed: float | None = None,
     crank7_motion: MotionLaw | None = None,
     crank7_start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("A", "C"),
-    radial_clearance: float = DEFAULT_RADIAL_CLEARANCE,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH,
-    material: Material = STEEL,
-    gravity: float = 9.81,
-    name: str = "seven_bar_press",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the hybrid-driven seven-bar press with clearance at the chosen joints.
 
@@ -136,11 +127,10 @@ def seven_bar_press(
             so that both have the same period.
         crank7_motion: a servo motion law theta(t) for crank 7, or None for constant speed.
         crank7_start_angle: crank 7 angle at t = 0 [rad] from +x.
-        clearance_at: joints with clearance, any of A, B, E, C, D (default the seed's A, C).
-        radial_clearance: c [m]; bearing_radius: R_B [m].
-        restitution, friction, law, material: contact properties of every clearance joint.
-        gravity: gravitational acceleration [m/s^2] along -y (default 9.81).
-        name: mechanism name.
+        clearance_at, radial_clearance, bearing_radius, restitution, friction, law,
+            material, gravity, name: the contact keywords (`ContactKeywords`);
+            ``clearance_at`` any of A, B, E, C, D (default the seed's A, C); ``gravity``
+            9.81 m/s^2 by default.
 
     Returns:
         The mechanism (2 drives: ``crank2`` on O2, ``crank7`` on O7).
@@ -150,28 +140,16 @@ def seven_bar_press(
             not close a loop at the start angles.
         AssemblyError: the start position is singular.
     """
-    dims = {
-        k: positive(k, v)
-        for k, v in (
-            ("crank2_length", crank2_length),
-            ("rod3_length", rod3_length),
-            ("plate4_length", plate4_length),
-            ("crank7_length", crank7_length),
-            ("rod5_length", rod5_length),
-        )
-    }
+    dims: dict[str, Any] = lengths(
+        crank2_length=crank2_length,
+        rod3_length=rod3_length,
+        plate4_length=plate4_length,
+        crank7_length=crank7_length,
+        rod5_length=rod5_length,
+    )
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(
-        clearance_at,
-        PRESS_INFO.clearable,
-        radial_clearance=radial_clearance,
-        bearing_radius=bearing_radius,
-        restitution=restitution,
-        friction=friction,
-        law=law,
-        material=material,
-    )
+    clr = ClearanceFactory(PRESS_INFO.clearable, contact)
     drive2 = _drive("crank2", "O2", crank2_speed, crank2_motion, crank2_start_angle)
     if crank7_speed is None:
         crank7_speed = crank2_motion.speed if crank2_motion is not None else crank2_speed
@@ -180,9 +158,8 @@ def seven_bar_press(
     pa = polar(o2, crank2_length, crank2_start_angle)
     pe = polar(o7, crank7_length, crank7_start_angle)
     pb = circle_circle(pa, rod3_length, pe, plate4_length, left=True, what="rod 3 / plate 4")
-    t4 = math.atan2(pe[1] - pb[1], pe[0] - pb[0])
     u, v = float(plate4_point[0]), float(plate4_point[1])
-    pc = (pb[0] + u * math.cos(t4) - v * math.sin(t4), pb[1] + u * math.sin(t4) + v * math.cos(t4))
+    pc = frame_point(pb, angle_of(pb, pe), (u, v))
     g6 = (float(guide_x), 0.0)
     pd = line_circle(g6, (0.0, 1.0), pc, rod5_length, forward=False, what="rod 5 / slider 6")
     links = (
@@ -195,13 +172,13 @@ def seven_bar_press(
         slider_link("slider6", {"D": pd}, mass=ms, inertia=js),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "rod3", "A"),
-        clr.revolute("B", "rod3", "B", "plate4", "B"),
-        clr.revolute("E", "plate4", "E", "crank7", "E"),
-        clr.revolute("O7", "ground", "O7", "crank7", "O7"),
-        clr.revolute("C", "plate4", "C", "rod5", "C"),
-        clr.revolute("D", "rod5", "D", "slider6", "D"),
+        clr.pin("O2", "ground", "crank2"),
+        clr.pin("A", "crank2", "rod3"),
+        clr.pin("B", "rod3", "plate4"),
+        clr.pin("E", "plate4", "crank7"),
+        clr.pin("O7", "ground", "crank7"),
+        clr.pin("C", "plate4", "rod5"),
+        clr.pin("D", "rod5", "slider6"),
         Joint("P6", JointType.PRISMATIC, "ground", "G6", "slider6", "D", axis=(0.0, 1.0)),
     )
     dims.update(
@@ -216,20 +193,10 @@ def seven_bar_press(
         crank7_speed=float(crank7_speed),
         crank7_start_angle=float(crank7_start_angle),
         **clr.parameters(),
-        gravity=float(gravity),
     )
     if crank2_motion is not None:
         dims["crank2_motion"] = _law_params(crank2_motion)
     if crank7_motion is not None:
         dims["crank7_motion"] = _law_params(crank7_motion)
-    return finish(
-        Mechanism(
-            name=name,
-            links=links,
-            joints=joints,
-            drives=(drive2, drive7),
-            outputs=(Output("slider_y", "slider6", OutputKind.POSITION_Y, point="D"),),
-            gravity=(0.0, -gravity),
-            parameters=dims,
-        )
-    )
+    output = Output("slider_y", "slider6", OutputKind.POSITION_Y, point="D")
+    return make_mechanism(clr, links, joints, (drive2, drive7), (output,), dims)

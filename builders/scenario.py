@@ -28,8 +28,9 @@ import os
 import re
 import tempfile
 import tomllib
+from collections.abc import Callable
 from pathlib import Path
-from typing import Any
+from typing import Any, TypeVar
 
 import tomli_w
 
@@ -55,9 +56,10 @@ __all__ = ["ScenarioError", "load_scenario", "loads_scenario", "dump_scenario", 
 
 _HEADER = "# clearance mechanism scenario: SI values, units in the key names.\n"
 _LAWS = [law.value for law in ContactLaw]
+_T = TypeVar("_T")
 
 
-def load_scenario(path: str | os.PathLike) -> Mechanism:
+def load_scenario(path: str | os.PathLike[str]) -> Mechanism:
     """Read a scenario file and return its `Mechanism`.
 
     Raises:
@@ -190,7 +192,8 @@ def _read_full(top: Table, mech: Table) -> Mechanism:
     )
 
 
-def _wrap(t: Table, key: str | None, make: Any) -> Any:
+def _wrap(t: Table, key: str | None, make: Callable[[], _T]) -> _T:
+    """``make()``, its ValueError or KeyError reported as a `ScenarioError` of ``t`` (and ``key``)."""
     try:
         return make()
     except ScenarioError:
@@ -199,24 +202,28 @@ def _wrap(t: Table, key: str | None, make: Any) -> Any:
         raise t.error(key, str(e).strip("\"'")) from None
 
 
-def _link_ref(t: Table, key: str, links: dict[str, Link], point_key: str | None = None) -> tuple[str, str | None]:
+def _link_ref(t: Table, key: str, links: dict[str, Link]) -> str:
     name = t.text(key)
     if name not in links:
         raise t.error(key, f"unknown link '{name}' (links: {sorted(links)})")
-    if point_key is None:
-        return name, None
-    point = t.text(point_key)
-    if point not in links[name].points:
-        raise t.error(point_key, f"link '{name}' has no point '{point}' (points: {sorted(links[name].points)})")
-    return name, point
+    return name
+
+
+def _point_ref(t: Table, key: str, link: Link) -> str:
+    point = t.text(key)
+    if point not in link.points:
+        raise t.error(key, f"link '{link.name}' has no point '{point}' (points: {sorted(link.points)})")
+    return point
 
 
 def _joint(t: Table, links: dict[str, Link]) -> Joint:
     name = t.text("name")
     kind = JointType(t.text("kind", choices=[k.value for k in JointType]))
-    la, pa = _link_ref(t, "link_a", links, "point_a")
-    lb, pb = _link_ref(t, "link_b", links, "point_b")
-    axis = tuple(t.convert_pair("axis", t.raw("axis"), 1.0)) if t.has("axis") else (1.0, 0.0)
+    la = _link_ref(t, "link_a", links)
+    pa = _point_ref(t, "point_a", links[la])
+    lb = _link_ref(t, "link_b", links)
+    pb = _point_ref(t, "point_b", links[lb])
+    axis = t.convert_pair("axis", t.raw("axis"), 1.0) if t.has("axis") else (1.0, 0.0)
     c = t.sub("clearance", "clearance")
     clearance = None
     if c is not None:
@@ -283,7 +290,8 @@ def _drive(t: Table, joints: set[str]) -> Drive:
 def _output(t: Table, links: dict[str, Link]) -> Output:
     name = t.text("name")
     kind = OutputKind(t.text("kind", choices=[k.value for k in OutputKind]))
-    link, point = _link_ref(t, "link", links, "point" if t.has("point") else None)
+    link = _link_ref(t, "link", links)
+    point = _point_ref(t, "point", links[link]) if t.has("point") else None
     t.finish(["name", "link", "kind", "point"])
     return _wrap(t, None, lambda: Output(name, link, kind, point))
 
@@ -388,7 +396,7 @@ def _compact(text: str) -> str:
         text = new
 
 
-def dump_scenario(mechanism: Mechanism, path: str | os.PathLike) -> None:
+def dump_scenario(mechanism: Mechanism, path: str | os.PathLike[str]) -> None:
     """Write a mechanism as a full-form scenario file, atomically (temp file, then rename).
 
     Raises:

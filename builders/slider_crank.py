@@ -10,19 +10,16 @@ quoted for this benchmark, not verified against the original papers.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from typing import Unpack
 
+from clearance.builders._contact import ClearanceFactory, ContactKeywords, contact_keywords
 from clearance.checks import positive
 from clearance.model import (
-    STEEL,
-    Clearance,
-    ContactLaw,
     Drive,
     DriveKind,
     Joint,
     JointType,
     Link,
-    Material,
     Mechanism,
     Output,
     OutputKind,
@@ -42,6 +39,7 @@ def rpm(value: float) -> float:
     return value * UNITS["angular_speed"]["rpm"]
 
 
+@contact_keywords(clearance_at=("rod_slider",), radial_clearance=0.5e-3)
 def slider_crank(
     *,
     crank_length: float = 0.05,
@@ -54,15 +52,7 @@ def slider_crank(
     slider_inertia: float = 1.0e-4,
     crank_speed: float = rpm(5000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("rod_slider",),
-    radial_clearance: float = 0.5e-3,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "slider_crank",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the in-line slider-crank with clearance at the chosen revolute joints.
 
@@ -78,14 +68,10 @@ def slider_crank(
         crank_speed: constant crank speed [rad/s] (default 5000 rpm; see `rpm`).
         start_angle: crank angle at t = 0 [rad] (0: crank along +x, slider at top dead
             centre).
-        clearance_at: joints with clearance, any of ``crank_rod`` and ``rod_slider``;
-            empty for the ideal mechanism.
-        radial_clearance: c [m] at every clearance joint.
-        bearing_radius: R_B [m].
-        restitution, friction, law: contact properties of every clearance joint.
-        material: journal and bearing material.
-        gravity: gravitational acceleration [m/s^2] along -y (0 for none).
-        name: mechanism name.
+        clearance_at, radial_clearance, bearing_radius, restitution, friction, law,
+            material, gravity, name: the contact keywords (`ContactKeywords`);
+            ``clearance_at`` any of ``crank_rod`` and ``rod_slider``; ``radial_clearance``
+            0.5 mm by default.
 
     Returns:
         The mechanism.
@@ -94,9 +80,7 @@ def slider_crank(
         ValueError: a value out of range, an unknown clearance joint, or a rod too short to
             close the loop.
     """
-    unknown = [j for j in clearance_at if j not in _CLEARABLE]
-    if unknown:
-        raise ValueError(f"clearance_at: unknown joint(s) {unknown}; expected any of {list(_CLEARABLE)}")
+    clr = ClearanceFactory(_CLEARABLE, contact)
     positive("crank_length", crank_length, "m")
     positive("rod_length", rod_length, "m")
     if rod_length <= crank_length:
@@ -136,23 +120,10 @@ def slider_crank(
         ),
     )
 
-    def clr(joint: str) -> Clearance | None:
-        if joint not in clearance_at:
-            return None
-        return Clearance(
-            radial_clearance=radial_clearance,
-            bearing_radius=bearing_radius,
-            bearing_material=material,
-            journal_material=material,
-            restitution=restitution,
-            friction=friction,
-            law=law,
-        )
-
     joints = (
         Joint("crank_pivot", JointType.REVOLUTE, "ground", "crank_pivot", "crank", "pivot"),
-        Joint("crank_rod", JointType.REVOLUTE, "crank", "pin", "rod", "big_end", clearance=clr("crank_rod")),
-        Joint("rod_slider", JointType.REVOLUTE, "rod", "small_end", "slider", "pin", clearance=clr("rod_slider")),
+        clr.revolute("crank_rod", "crank", "pin", "rod", "big_end"),
+        clr.revolute("rod_slider", "rod", "small_end", "slider", "pin"),
         Joint("slider_guide", JointType.PRISMATIC, "ground", "guide", "slider", "pin", axis=(1.0, 0.0)),
     )
     drives = (Drive("crank", "crank_pivot", DriveKind.CONSTANT_SPEED, speed=crank_speed, start_angle=th),)
@@ -168,20 +139,14 @@ def slider_crank(
         "slider_inertia": slider_inertia,
         "crank_speed": crank_speed,
         "start_angle": th,
-        "clearance_at": list(clearance_at),
-        "radial_clearance": radial_clearance,
-        "bearing_radius": bearing_radius,
-        "restitution": restitution,
-        "friction": friction,
-        "law": law.value,
-        "gravity": gravity,
+        **clr.parameters(),
     }
     return Mechanism(
-        name=name,
+        name=clr.name,
         links=links,
         joints=joints,
         drives=drives,
         outputs=outputs,
-        gravity=(0.0, -gravity),
+        gravity=(0.0, -clr.gravity),
         parameters=params,
     )

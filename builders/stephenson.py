@@ -25,41 +25,37 @@ farthest from 0 and 180 deg over the whole revolution (see docs/catalogue/catalo
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from collections.abc import Sequence
+from typing import Any, Unpack
 
+from clearance.builders._contact import ClearanceFactory, ContactKeywords, contact_keywords
 from clearance.builders._linkage import (
     DEFAULT_LINEAR_DENSITY as _LAM,
 )
 from clearance.builders._linkage import (
-    DEFAULT_RADIAL_CLEARANCE as _C,
-)
-from clearance.builders._linkage import (
-    ClearanceFactory,
     LinkageInfo,
     advance,
+    angle_of,
     bar_link,
     circle_circle,
-    finish,
-    line_circle,
+    crank_mechanism,
+    lengths,
     polar,
     positive,
     slider_link,
 )
+from clearance.builders._loops import (
+    coupler_bars,
+    coupler_point,
+    crank_rocker,
+    crank_rocker_joints,
+    slider_crank_joints,
+    slider_crank_loop,
+)
 from clearance.builders.slider_crank import rpm
 from clearance.kinematics import TransmissionAngle as _T
-from clearance.model import (
-    STEEL,
-    ContactLaw,
-    Drive,
-    Joint,
-    JointType,
-    Link,
-    Material,
-    Mechanism,
-    Output,
-    OutputKind,
-)
+from clearance.model import Link, Mechanism, Output, OutputKind
 
 __all__ = [
     "stephenson_i",
@@ -73,7 +69,6 @@ __all__ = [
 ]
 
 _OWN = "project's own dimensions (grid search for the best transmission angle of the dyads)"
-_LN = ContactLaw.LANKARANI_NIKRAVESH
 
 STEPHENSON_I_INFO = LinkageInfo(
     topology="Stephenson I: ground 1 (binary: O2, O4), ternary crank 2 (O2, A, E; driven), coupler 3 "
@@ -127,61 +122,7 @@ STEPHENSON_II_2_INFO = LinkageInfo(
 )
 
 
-def _setup(
-    info: LinkageInfo,
-    clearance_at: Sequence[str],
-    radial_clearance: float,
-    bearing_radius: float,
-    restitution: float,
-    friction: float,
-    law: ContactLaw,
-    material: Material,
-) -> ClearanceFactory:
-    return ClearanceFactory(
-        clearance_at,
-        info.clearable,
-        radial_clearance=radial_clearance,
-        bearing_radius=bearing_radius,
-        restitution=restitution,
-        friction=friction,
-        law=law,
-        material=material,
-    )
-
-
-def _build(
-    name: str,
-    links: Sequence[Link],
-    joints: Sequence[Joint],
-    output: Output,
-    crank_speed: float,
-    start_angle: float,
-    gravity: float,
-    lam: float,
-    clr: ClearanceFactory,
-    dims: dict,
-) -> Mechanism:
-    params = {
-        **dims,
-        "linear_density": lam,
-        "crank_speed": float(crank_speed),
-        "start_angle": float(start_angle),
-        **clr.parameters(),
-        "gravity": float(gravity),
-    }
-    return finish(
-        Mechanism(
-            name=name,
-            links=tuple(links),
-            joints=tuple(joints),
-            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-            outputs=(output,),
-            gravity=(0.0, -gravity),
-            parameters=params,
-        )
-    )
-
-
+@contact_keywords(clearance_at=("B",))
 def stephenson_i(
     *,
     crank_length: float = 0.04,
@@ -197,15 +138,7 @@ def stephenson_i(
     linear_density: float = _LAM,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("B",),
-    radial_clearance: float = _C,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = _LN,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "stephenson_i",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the Stephenson I six-bar (four-bar plus a dyad from crank to rocker).
 
@@ -220,38 +153,31 @@ def stephenson_i(
         linear_density: mass per length of the steel bars [kg/m].
         crank_speed: constant crank speed [rad/s] (default 1000 rpm).
         start_angle: crank angle at t = 0 [rad] from +x.
-        clearance_at: joints with clearance (see `STEPHENSON_I_INFO.clearable`).
-        radial_clearance, bearing_radius: c and R_B [m].
-        restitution, friction, law, material: contact properties of every clearance joint.
-        gravity: gravitational acceleration [m/s^2] along -y (0 for none).
-        name: mechanism name.
+        clearance_at, radial_clearance, bearing_radius, restitution, friction, law,
+            material, gravity, name: the contact keywords (`ContactKeywords`);
+            ``clearance_at`` any of `STEPHENSON_I_INFO.clearable`.
 
     Raises:
         ValueError: a value out of range, an unknown clearance joint, or lengths that do
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {
-        k: positive(k, v)
-        for k, v in (
-            ("crank_length", crank_length),
-            ("crank_arm", crank_arm),
-            ("coupler3_length", coupler3_length),
-            ("rocker4_length", rocker4_length),
-            ("ground_length", ground_length),
-            ("rocker4_arm", rocker4_arm),
-            ("link5_length", link5_length),
-            ("link6_length", link6_length),
-        )
-    }
-    lam = positive("linear_density", linear_density, "kg/m")
-    clr = _setup(
-        STEPHENSON_I_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction, law, material
+    dims: dict[str, Any] = lengths(
+        crank_length=crank_length,
+        crank_arm=crank_arm,
+        coupler3_length=coupler3_length,
+        rocker4_length=rocker4_length,
+        ground_length=ground_length,
+        rocker4_arm=rocker4_arm,
+        link5_length=link5_length,
+        link6_length=link6_length,
     )
-    o2, o4 = (0.0, 0.0), (ground_length, 0.0)
-    pa, pe = polar(o2, crank_length, start_angle), polar(o2, crank_arm, start_angle + crank_arm_angle)
-    pb = circle_circle(pa, coupler3_length, o4, rocker4_length, left=True, what="coupler 3 / rocker 4")
-    pf = polar(o4, rocker4_arm, math.atan2(pb[1] - o4[1], pb[0] - o4[0]) + rocker4_arm_angle)
+    lam = positive("linear_density", linear_density, "kg/m")
+    clr = ClearanceFactory(STEPHENSON_I_INFO.clearable, contact)
+    p = crank_rocker(crank_length, coupler3_length, rocker4_length, ground_length, start_angle)
+    o2, o4, pa, pb = p["O2"], p["O4"], p["A"], p["B"]
+    pe = polar(o2, crank_arm, start_angle + crank_arm_angle)
+    pf = polar(o4, rocker4_arm, angle_of(o4, pb) + rocker4_arm_angle)
     pg = circle_circle(pe, link5_length, pf, link6_length, left=False, what="link 5 / link 6")
     links = (
         Link("ground", 0.0, 0.0, points={"O2": o2, "O4": o4}),
@@ -262,29 +188,25 @@ def stephenson_i(
         bar_link("link6", {"G": pg, "F": pf}, density=lam),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
-        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("E", "crank2", "E", "link5", "E"),
-        clr.revolute("G", "link5", "G", "link6", "G"),
-        clr.revolute("F", "link6", "F", "rocker4", "F"),
+        *crank_rocker_joints(clr),
+        clr.pin("E", "crank2", "link5"),
+        clr.pin("G", "link5", "link6"),
+        clr.pin("F", "link6", "rocker4"),
     )
     dims.update(crank_arm_angle=float(crank_arm_angle), rocker4_arm_angle=float(rocker4_arm_angle))
-    return _build(
-        name,
+    return crank_mechanism(
+        clr,
         links,
         joints,
         Output("rocker_angle", "rocker4", OutputKind.ANGLE),
-        crank_speed,
-        start_angle,
-        gravity,
-        lam,
-        clr,
         dims,
+        linear_density=lam,
+        crank_speed=crank_speed,
+        start_angle=start_angle,
     )
 
 
+@contact_keywords(clearance_at=("B",))
 def stephenson_i_slider(
     *,
     crank_length: float = 0.04,
@@ -299,15 +221,7 @@ def stephenson_i_slider(
     linear_density: float = _LAM,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("B",),
-    radial_clearance: float = _C,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = _LN,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "stephenson_i_slider",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the Stephenson I six-bar with an output slider (in-line, on the x axis).
 
@@ -328,26 +242,20 @@ def stephenson_i_slider(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {
-        k: positive(k, v)
-        for k, v in (
-            ("crank_length", crank_length),
-            ("crank_arm", crank_arm),
-            ("rod3_length", rod3_length),
-            ("link5_length", link5_length),
-            ("link6_length", link6_length),
-        )
-    }
+    dims: dict[str, Any] = lengths(
+        crank_length=crank_length,
+        crank_arm=crank_arm,
+        rod3_length=rod3_length,
+        link5_length=link5_length,
+        link6_length=link6_length,
+    )
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = _setup(
-        STEPHENSON_I_SLIDER_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction, law, material
-    )
-    o2 = (0.0, 0.0)
-    pa, pe = polar(o2, crank_length, start_angle), polar(o2, crank_arm, start_angle + crank_arm_angle)
-    pb = line_circle(o2, (1.0, 0.0), pa, rod3_length, forward=True, what="rod 3 / slider 4")
+    clr = ClearanceFactory(STEPHENSON_I_SLIDER_INFO.clearable, contact)
     off = (float(slider_pin_offset[0]), float(slider_pin_offset[1]))
-    pf = (pb[0] + off[0], pb[1] + off[1])
+    p = slider_crank_loop(crank_length, rod3_length, start_angle, pin="F", offset=off)
+    o2, pa, pb, pf = p["O2"], p["A"], p["B"], p["F"]
+    pe = polar(o2, crank_arm, start_angle + crank_arm_angle)
     pg = circle_circle(pe, link5_length, pf, link6_length, left=False, what="link 5 / link 6")
     links = (
         Link("ground", 0.0, 0.0, points={"O2": o2, "G4": (rod3_length, 0.0)}),
@@ -358,29 +266,25 @@ def stephenson_i_slider(
         bar_link("link6", {"G": pg, "F": pf}, density=lam),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "rod3", "A"),
-        clr.revolute("B", "rod3", "B", "slider4", "B"),
-        Joint("P4", JointType.PRISMATIC, "ground", "G4", "slider4", "B", axis=(1.0, 0.0)),
-        clr.revolute("E", "crank2", "E", "link5", "E"),
-        clr.revolute("G", "link5", "G", "link6", "G"),
-        clr.revolute("F", "link6", "F", "slider4", "F"),
+        *slider_crank_joints(clr),
+        clr.pin("E", "crank2", "link5"),
+        clr.pin("G", "link5", "link6"),
+        clr.pin("F", "link6", "slider4"),
     )
     dims.update(crank_arm_angle=float(crank_arm_angle), slider_pin_offset=list(off), slider_mass=ms, slider_inertia=js)
-    return _build(
-        name,
+    return crank_mechanism(
+        clr,
         links,
         joints,
         Output("slider_x", "slider4", OutputKind.POSITION_X, point="B"),
-        crank_speed,
-        start_angle,
-        gravity,
-        lam,
-        clr,
         dims,
+        linear_density=lam,
+        crank_speed=crank_speed,
+        start_angle=start_angle,
     )
 
 
+@contact_keywords(clearance_at=("D",))
 def stephenson_ii_1(
     *,
     crank_length: float = 0.04,
@@ -394,15 +298,7 @@ def stephenson_ii_1(
     linear_density: float = _LAM,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("D",),
-    radial_clearance: float = _C,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = _LN,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "stephenson_ii_1",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build Stephenson II (1): a crank-rocker whose coupler point drives a dyad to rocker 6.
 
@@ -422,60 +318,50 @@ def stephenson_ii_1(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    dims = {
-        k: positive(k, v)
-        for k, v in (
-            ("crank_length", crank_length),
-            ("coupler3_length", coupler3_length),
-            ("rocker4_length", rocker4_length),
-            ("ground_length", ground_length),
-            ("link5_length", link5_length),
-            ("rocker6_length", rocker6_length),
-        )
-    }
-    lam = positive("linear_density", linear_density, "kg/m")
-    clr = _setup(
-        STEPHENSON_II_1_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction, law, material
+    dims: dict[str, Any] = lengths(
+        crank_length=crank_length,
+        coupler3_length=coupler3_length,
+        rocker4_length=rocker4_length,
+        ground_length=ground_length,
+        link5_length=link5_length,
+        rocker6_length=rocker6_length,
     )
-    o2, o4, o6 = (0.0, 0.0), (ground_length, 0.0), (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
-    pa = polar(o2, crank_length, start_angle)
-    pb = circle_circle(pa, coupler3_length, o4, rocker4_length, left=True, what="coupler 3 / rocker 4")
-    th3 = math.atan2(pb[1] - pa[1], pb[0] - pa[0])
+    lam = positive("linear_density", linear_density, "kg/m")
+    clr = ClearanceFactory(STEPHENSON_II_1_INFO.clearable, contact)
+    o6 = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
+    p = crank_rocker(crank_length, coupler3_length, rocker4_length, ground_length, start_angle)
+    o2, o4, pa, pb = p["O2"], p["O4"], p["A"], p["B"]
     u, v = float(coupler3_point[0]), float(coupler3_point[1])
-    pc = (pa[0] + u * math.cos(th3) - v * math.sin(th3), pa[1] + u * math.sin(th3) + v * math.cos(th3))
+    pc = coupler_point(p, (u, v))
     pd = circle_circle(pc, link5_length, o6, rocker6_length, left=True, what="link 5 / rocker 6")
     links = (
         Link("ground", 0.0, 0.0, points={"O2": o2, "O4": o4, "O6": o6}),
         bar_link("crank2", {"O2": o2, "A": pa}, density=lam),
-        bar_link("coupler3", {"A": pa, "B": pb, "C": pc}, density=lam, bars=_ternary_bars("A", "B", "C", u, v)),
+        bar_link("coupler3", {"A": pa, "B": pb, "C": pc}, density=lam, bars=coupler_bars((u, v))),
         bar_link("rocker4", {"O4": o4, "B": pb}, density=lam),
         bar_link("link5", {"C": pc, "D": pd}, density=lam),
         bar_link("rocker6", {"O6": o6, "D": pd}, density=lam),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
-        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("C", "coupler3", "C", "link5", "C"),
-        clr.revolute("D", "link5", "D", "rocker6", "D"),
-        clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
+        *crank_rocker_joints(clr),
+        clr.pin("C", "coupler3", "link5"),
+        clr.pin("D", "link5", "rocker6"),
+        clr.pin("O6", "ground", "rocker6"),
     )
     dims.update(coupler3_point=[u, v], rocker6_pivot=list(o6))
-    return _build(
-        name,
+    return crank_mechanism(
+        clr,
         links,
         joints,
         Output("rocker_angle", "rocker6", OutputKind.ANGLE),
-        crank_speed,
-        start_angle,
-        gravity,
-        lam,
-        clr,
         dims,
+        linear_density=lam,
+        crank_speed=crank_speed,
+        start_angle=start_angle,
     )
 
 
+@contact_keywords(clearance_at=("B",))
 def stephenson_ii_2(
     *,
     crank_length: float = 0.03,
@@ -489,15 +375,7 @@ def stephenson_ii_2(
     linear_density: float = _LAM,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("B",),
-    radial_clearance: float = _C,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = _LN,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "stephenson_ii_2",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build Stephenson II (2): crank and rod drive the coupler of a double rocker.
 
@@ -519,20 +397,15 @@ def stephenson_ii_2(
         ValueError: a value out of range or an unknown clearance joint.
         AssemblyError: the loops cannot be closed, or the start position is singular.
     """
-    dims = {
-        k: positive(k, v)
-        for k, v in (
-            ("crank_length", crank_length),
-            ("rod3_length", rod3_length),
-            ("coupler4_length", coupler4_length),
-            ("rocker5_length", rocker5_length),
-            ("rocker6_length", rocker6_length),
-        )
-    }
-    lam = positive("linear_density", linear_density, "kg/m")
-    clr = _setup(
-        STEPHENSON_II_2_INFO, clearance_at, radial_clearance, bearing_radius, restitution, friction, law, material
+    dims: dict[str, Any] = lengths(
+        crank_length=crank_length,
+        rod3_length=rod3_length,
+        coupler4_length=coupler4_length,
+        rocker5_length=rocker5_length,
+        rocker6_length=rocker6_length,
     )
+    lam = positive("linear_density", linear_density, "kg/m")
+    clr = ClearanceFactory(STEPHENSON_II_2_INFO.clearable, contact)
     o2 = (0.0, 0.0)
     o5, o6 = (float(rocker5_pivot[0]), float(rocker5_pivot[1])), (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
     # rough pose at crank angle 0 (rockers hanging down, coupler horizontal); Newton closes it
@@ -557,35 +430,27 @@ def stephenson_ii_2(
         _resized(links[5], "O6", "D", rocker6_length, lam),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "rod3", "A"),
-        clr.revolute("B", "rod3", "B", "coupler4", "B"),
-        clr.revolute("C", "coupler4", "C", "rocker5", "C"),
-        clr.revolute("O5", "ground", "O5", "rocker5", "O5"),
-        clr.revolute("D", "coupler4", "D", "rocker6", "D"),
-        clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
+        clr.pin("O2", "ground", "crank2"),
+        clr.pin("A", "crank2", "rod3"),
+        clr.pin("B", "rod3", "coupler4"),
+        clr.pin("C", "coupler4", "rocker5"),
+        clr.pin("O5", "ground", "rocker5"),
+        clr.pin("D", "coupler4", "rocker6"),
+        clr.pin("O6", "ground", "rocker6"),
     )
     dims.update(coupler4_point=[u, v], rocker5_pivot=list(o5), rocker6_pivot=list(o6))
-    mech = _build(
-        name,
+    mech = crank_mechanism(
+        clr,
         links,
         joints,
         Output("rocker_angle", "rocker5", OutputKind.ANGLE),
-        crank_speed,
-        0.0,
-        gravity,
-        lam,
-        clr,
         dims,
+        linear_density=lam,
+        crank_speed=crank_speed,
+        start_angle=0.0,
     )
     mech = advance(mech, float(start_angle))
     return _with_params(mech, start_angle=float(start_angle))
-
-
-def _ternary_bars(a: str, b: str, c: str, u: float, v: float) -> list[tuple[str, str]]:
-    """Bars of a ternary link with c at (u, v) in the frame (a, x towards b): a straight bar
-    when the three points are collinear, a triangle otherwise."""
-    return [(a, c)] if v == 0 and u >= 0 else [(a, b), (b, c), (c, a)]
 
 
 def _resized(link: Link, p0: str, p1: str, length: float, lam: float) -> Link:
@@ -594,7 +459,5 @@ def _resized(link: Link, p0: str, p1: str, length: float, lam: float) -> Link:
     return bar_link(link.name, {p0: (x, y), p1: (x + length * math.cos(th), y + length * math.sin(th))}, density=lam)
 
 
-def _with_params(mech: Mechanism, **changes: object) -> Mechanism:
-    import dataclasses
-
+def _with_params(mech: Mechanism, **changes: Any) -> Mechanism:
     return dataclasses.replace(mech, parameters={**mech.parameters, **changes})

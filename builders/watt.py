@@ -17,35 +17,26 @@ about 90 +- 35 deg.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from typing import Any, Unpack
 
+from clearance.builders._contact import ClearanceFactory, ContactKeywords, contact_keywords
 from clearance.builders._linkage import (
     DEFAULT_LINEAR_DENSITY,
-    DEFAULT_RADIAL_CLEARANCE,
-    ClearanceFactory,
     LinkageInfo,
+    Point,
+    angle_of,
     bar_link,
     circle_circle,
-    finish,
+    crank_mechanism,
     line_circle,
     polar,
     positive,
     slider_link,
 )
+from clearance.builders._loops import crank_rocker, crank_rocker_joints, slider_crank_joints, slider_crank_loop
 from clearance.builders.slider_crank import rpm
 from clearance.kinematics import TransmissionAngle
-from clearance.model import (
-    STEEL,
-    ContactLaw,
-    Drive,
-    Joint,
-    JointType,
-    Link,
-    Material,
-    Mechanism,
-    Output,
-    OutputKind,
-)
+from clearance.model import Joint, JointType, Link, Mechanism, Output, OutputKind
 
 __all__ = [
     "watt_six_bar",
@@ -104,27 +95,35 @@ WATT_SLIDER_2_INFO = LinkageInfo(
 )
 
 
-def _crank_rocker(a: float, b: float, c: float, d: float, th: float, lam: float) -> tuple[list[Link], dict]:
-    """Loop 1 shared by the plain Watt and slider (1): crank 2, coupler 3, rocker 4 (O4-B)."""
-    o2, o4 = (0.0, 0.0), (d, 0.0)
-    pa = polar(o2, a, th)
-    pb = circle_circle(pa, b, o4, c, left=True, what="coupler 3 / rocker 4")
+def _loop1_lengths(crank: float, coupler3: float, rocker4: float, ground: float) -> tuple[float, float, float, float]:
+    """The checked lengths [m] of loop 1 of the plain Watt and slider (1)."""
+    return (
+        positive("crank_length", crank),
+        positive("coupler3_length", coupler3),
+        positive("rocker4_length", rocker4),
+        positive("ground_length", ground),
+    )
+
+
+def _loop1(
+    a: float, b: float, c: float, d: float, e: float, arm_angle: float, th: float, lam: float
+) -> tuple[list[Link], dict[str, Point]]:
+    """Loop 1 of the plain Watt and slider (1): crank 2, coupler 3, ternary rocker 4 (O4, B, C)."""
+    p = crank_rocker(a, b, c, d, th)
+    p["C"] = polar(p["O4"], e, angle_of(p["O4"], p["B"]) + arm_angle)
     return [
-        bar_link("crank2", {"O2": o2, "A": pa}, density=lam),
-        bar_link("coupler3", {"A": pa, "B": pb}, density=lam),
-    ], {"O2": o2, "O4": o4, "A": pa, "B": pb}
+        bar_link("crank2", {"O2": p["O2"], "A": p["A"]}, density=lam),
+        bar_link("coupler3", {"A": p["A"], "B": p["B"]}, density=lam),
+        bar_link("rocker4", {"O4": p["O4"], "B": p["B"], "C": p["C"]}, density=lam),
+    ], p
 
 
-def _common(clr: ClearanceFactory, crank_speed: float, start_angle: float, lam: float, gravity: float) -> dict:
-    return {
-        "linear_density": lam,
-        "crank_speed": float(crank_speed),
-        "start_angle": float(start_angle),
-        **clr.parameters(),
-        "gravity": float(gravity),
-    }
+def _loop1_joints(clr: ClearanceFactory, link5: str) -> tuple[Joint, ...]:
+    """The joints of loop 1 (O2, A, B, O4) and of rocker 4's arm C to ``link5``."""
+    return (*crank_rocker_joints(clr), clr.pin("C", "rocker4", link5))
 
 
+@contact_keywords(clearance_at=("D",))
 def watt_six_bar(
     *,
     crank_length: float = 0.04,
@@ -139,15 +138,7 @@ def watt_six_bar(
     linear_density: float = DEFAULT_LINEAR_DENSITY,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("D",),
-    radial_clearance: float = DEFAULT_RADIAL_CLEARANCE,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "watt_six_bar",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the plain Watt II six-bar (two crank-rocker loops in series).
 
@@ -164,26 +155,16 @@ def watt_six_bar(
         linear_density: mass per length of the steel bars [kg/m].
         crank_speed: constant crank speed [rad/s] (default 1000 rpm).
         start_angle: crank angle at t = 0 [rad] from +x.
-        clearance_at: joints with clearance, any of A, B, O4, C, D, O6.
-        radial_clearance: c [m]; bearing_radius: R_B [m].
-        restitution, friction, law, material: contact properties of every clearance joint.
-        gravity: gravitational acceleration [m/s^2] along -y (0 for none).
-        name: mechanism name.
+        clearance_at, radial_clearance, bearing_radius, restitution, friction, law,
+            material, gravity, name: the contact keywords (`ContactKeywords`);
+            ``clearance_at`` any of A, B, O4, C, D, O6.
 
     Raises:
         ValueError: a value out of range, an unknown clearance joint, or lengths that do
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    a, b, c, d = (
-        positive(n, v)
-        for n, v in (
-            ("crank_length", crank_length),
-            ("coupler3_length", coupler3_length),
-            ("rocker4_length", rocker4_length),
-            ("ground_length", ground_length),
-        )
-    )
+    a, b, c, d = _loop1_lengths(crank_length, coupler3_length, rocker4_length, ground_length)
     e, f, g = (
         positive(n, v)
         for n, v in (
@@ -193,38 +174,22 @@ def watt_six_bar(
         )
     )
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(
-        clearance_at,
-        WATT_INFO.clearable,
-        radial_clearance=radial_clearance,
-        bearing_radius=bearing_radius,
-        restitution=restitution,
-        friction=friction,
-        law=law,
-        material=material,
-    )
-    links, p = _crank_rocker(a, b, c, d, start_angle, lam)
+    clr = ClearanceFactory(WATT_INFO.clearable, contact)
+    loop1, p = _loop1(a, b, c, d, e, rocker4_arm_angle, start_angle, lam)
     o6 = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
-    th4 = math.atan2(p["B"][1] - p["O4"][1], p["B"][0] - p["O4"][0])
-    pc = polar(p["O4"], e, th4 + rocker4_arm_angle)
-    pd = circle_circle(pc, f, o6, g, left=False, what="coupler 5 / rocker 6")
+    pd = circle_circle(p["C"], f, o6, g, left=False, what="coupler 5 / rocker 6")
     links = [
         Link("ground", 0.0, 0.0, points={"O2": p["O2"], "O4": p["O4"], "O6": o6}),
-        *links,
-        bar_link("rocker4", {"O4": p["O4"], "B": p["B"], "C": pc}, density=lam),
-        bar_link("coupler5", {"C": pc, "D": pd}, density=lam),
+        *loop1,
+        bar_link("coupler5", {"C": p["C"], "D": pd}, density=lam),
         bar_link("rocker6", {"O6": o6, "D": pd}, density=lam),
     ]
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
-        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("C", "rocker4", "C", "coupler5", "C"),
-        clr.revolute("D", "coupler5", "D", "rocker6", "D"),
-        clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
+        *_loop1_joints(clr, "coupler5"),
+        clr.pin("D", "coupler5", "rocker6"),
+        clr.pin("O6", "ground", "rocker6"),
     )
-    params = {
+    dims: dict[str, Any] = {
         "crank_length": a,
         "coupler3_length": b,
         "rocker4_length": c,
@@ -234,21 +199,14 @@ def watt_six_bar(
         "coupler5_length": f,
         "rocker6_length": g,
         "rocker6_pivot": list(o6),
-        **_common(clr, crank_speed, start_angle, lam, gravity),
     }
-    return finish(
-        Mechanism(
-            name=name,
-            links=tuple(links),
-            joints=joints,
-            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-            outputs=(Output("rocker_angle", "rocker6", OutputKind.ANGLE),),
-            gravity=(0.0, -gravity),
-            parameters=params,
-        )
+    output = Output("rocker_angle", "rocker6", OutputKind.ANGLE)
+    return crank_mechanism(
+        clr, links, joints, output, dims, linear_density=lam, crank_speed=crank_speed, start_angle=start_angle
     )
 
 
+@contact_keywords(clearance_at=("D",))
 def watt_six_bar_slider_1(
     *,
     crank_length: float = 0.04,
@@ -264,15 +222,7 @@ def watt_six_bar_slider_1(
     linear_density: float = DEFAULT_LINEAR_DENSITY,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("D",),
-    radial_clearance: float = DEFAULT_RADIAL_CLEARANCE,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "watt_six_bar_slider_1",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the Watt II six-bar whose output is a slider driven by the ternary rocker.
 
@@ -294,50 +244,26 @@ def watt_six_bar_slider_1(
             not close a loop at the start angle.
         AssemblyError: the start position is singular.
     """
-    a, b, c, d = (
-        positive(n, v)
-        for n, v in (
-            ("crank_length", crank_length),
-            ("coupler3_length", coupler3_length),
-            ("rocker4_length", rocker4_length),
-            ("ground_length", ground_length),
-        )
-    )
+    a, b, c, d = _loop1_lengths(crank_length, coupler3_length, rocker4_length, ground_length)
     e, f = positive("rocker4_arm", rocker4_arm), positive("rod5_length", rod5_length)
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(
-        clearance_at,
-        WATT_SLIDER_1_INFO.clearable,
-        radial_clearance=radial_clearance,
-        bearing_radius=bearing_radius,
-        restitution=restitution,
-        friction=friction,
-        law=law,
-        material=material,
-    )
-    links, p = _crank_rocker(a, b, c, d, start_angle, lam)
-    th4 = math.atan2(p["B"][1] - p["O4"][1], p["B"][0] - p["O4"][0])
-    pc = polar(p["O4"], e, th4 + rocker4_arm_angle)
+    clr = ClearanceFactory(WATT_SLIDER_1_INFO.clearable, contact)
+    loop1, p = _loop1(a, b, c, d, e, rocker4_arm_angle, start_angle, lam)
     g6 = (d + f, float(guide_height))
-    pd = line_circle(g6, (1.0, 0.0), pc, f, forward=True, what="rod 5 / slider 6")
+    pd = line_circle(g6, (1.0, 0.0), p["C"], f, forward=True, what="rod 5 / slider 6")
     links = [
         Link("ground", 0.0, 0.0, points={"O2": p["O2"], "O4": p["O4"], "G6": g6}),
-        *links,
-        bar_link("rocker4", {"O4": p["O4"], "B": p["B"], "C": pc}, density=lam),
-        bar_link("rod5", {"C": pc, "D": pd}, density=lam),
+        *loop1,
+        bar_link("rod5", {"C": p["C"], "D": pd}, density=lam),
         slider_link("slider6", {"D": pd}, mass=ms, inertia=js),
     ]
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "coupler3", "A"),
-        clr.revolute("B", "coupler3", "B", "rocker4", "B"),
-        clr.revolute("O4", "ground", "O4", "rocker4", "O4"),
-        clr.revolute("C", "rocker4", "C", "rod5", "C"),
-        clr.revolute("D", "rod5", "D", "slider6", "D"),
+        *_loop1_joints(clr, "rod5"),
+        clr.pin("D", "rod5", "slider6"),
         Joint("P6", JointType.PRISMATIC, "ground", "G6", "slider6", "D", axis=(1.0, 0.0)),
     )
-    params = {
+    dims: dict[str, Any] = {
         "crank_length": a,
         "coupler3_length": b,
         "rocker4_length": c,
@@ -348,21 +274,14 @@ def watt_six_bar_slider_1(
         "guide_height": float(guide_height),
         "slider_mass": ms,
         "slider_inertia": js,
-        **_common(clr, crank_speed, start_angle, lam, gravity),
     }
-    return finish(
-        Mechanism(
-            name=name,
-            links=tuple(links),
-            joints=joints,
-            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-            outputs=(Output("slider_x", "slider6", OutputKind.POSITION_X, point="D"),),
-            gravity=(0.0, -gravity),
-            parameters=params,
-        )
+    output = Output("slider_x", "slider6", OutputKind.POSITION_X, point="D")
+    return crank_mechanism(
+        clr, links, joints, output, dims, linear_density=lam, crank_speed=crank_speed, start_angle=start_angle
     )
 
 
+@contact_keywords(clearance_at=("D",))
 def watt_six_bar_slider_2(
     *,
     crank_length: float = 0.04,
@@ -376,15 +295,7 @@ def watt_six_bar_slider_2(
     linear_density: float = DEFAULT_LINEAR_DENSITY,
     crank_speed: float = rpm(1000.0),
     start_angle: float = 0.0,
-    clearance_at: Sequence[str] = ("D",),
-    radial_clearance: float = DEFAULT_RADIAL_CLEARANCE,
-    bearing_radius: float = 0.010,
-    restitution: float = 0.9,
-    friction: float = 0.0,
-    law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH,
-    material: Material = STEEL,
-    gravity: float = 0.0,
-    name: str = "watt_six_bar_slider_2",
+    **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the Watt II six-bar whose first loop is an in-line slider-crank.
 
@@ -412,40 +323,26 @@ def watt_six_bar_slider_2(
     lam = positive("linear_density", linear_density, "kg/m")
     if b <= a:
         raise ValueError(f"rod3_length must be > crank_length = {a} m (got {b} m)")
-    clr = ClearanceFactory(
-        clearance_at,
-        WATT_SLIDER_2_INFO.clearable,
-        radial_clearance=radial_clearance,
-        bearing_radius=bearing_radius,
-        restitution=restitution,
-        friction=friction,
-        law=law,
-        material=material,
-    )
-    o2, o6 = (0.0, 0.0), (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
-    pa = polar(o2, a, start_angle)
-    pb = line_circle(o2, (1.0, 0.0), pa, b, forward=True, what="rod 3 / slider 4")
+    clr = ClearanceFactory(WATT_SLIDER_2_INFO.clearable, contact)
+    o6 = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
     off = (float(slider_pin_offset[0]), float(slider_pin_offset[1]))
-    pc = (pb[0] + off[0], pb[1] + off[1])
-    pd = circle_circle(pc, f, o6, g, left=False, what="coupler 5 / rocker 6")
+    p = slider_crank_loop(a, b, start_angle, pin="C", offset=off)
+    pd = circle_circle(p["C"], f, o6, g, left=False, what="coupler 5 / rocker 6")
     links = (
-        Link("ground", 0.0, 0.0, points={"O2": o2, "G4": (b, 0.0), "O6": o6}),
-        bar_link("crank2", {"O2": o2, "A": pa}, density=lam),
-        bar_link("rod3", {"A": pa, "B": pb}, density=lam),
-        slider_link("slider4", {"B": pb, "C": pc}, mass=ms, inertia=js),
-        bar_link("coupler5", {"C": pc, "D": pd}, density=lam),
+        Link("ground", 0.0, 0.0, points={"O2": p["O2"], "G4": (b, 0.0), "O6": o6}),
+        bar_link("crank2", {"O2": p["O2"], "A": p["A"]}, density=lam),
+        bar_link("rod3", {"A": p["A"], "B": p["B"]}, density=lam),
+        slider_link("slider4", {"B": p["B"], "C": p["C"]}, mass=ms, inertia=js),
+        bar_link("coupler5", {"C": p["C"], "D": pd}, density=lam),
         bar_link("rocker6", {"O6": o6, "D": pd}, density=lam),
     )
     joints = (
-        clr.revolute("O2", "ground", "O2", "crank2", "O2"),
-        clr.revolute("A", "crank2", "A", "rod3", "A"),
-        clr.revolute("B", "rod3", "B", "slider4", "B"),
-        Joint("P4", JointType.PRISMATIC, "ground", "G4", "slider4", "B", axis=(1.0, 0.0)),
-        clr.revolute("C", "slider4", "C", "coupler5", "C"),
-        clr.revolute("D", "coupler5", "D", "rocker6", "D"),
-        clr.revolute("O6", "ground", "O6", "rocker6", "O6"),
+        *slider_crank_joints(clr),
+        clr.pin("C", "slider4", "coupler5"),
+        clr.pin("D", "coupler5", "rocker6"),
+        clr.pin("O6", "ground", "rocker6"),
     )
-    params = {
+    dims: dict[str, Any] = {
         "crank_length": a,
         "rod3_length": b,
         "slider_pin_offset": list(off),
@@ -454,16 +351,8 @@ def watt_six_bar_slider_2(
         "rocker6_pivot": list(o6),
         "slider_mass": ms,
         "slider_inertia": js,
-        **_common(clr, crank_speed, start_angle, lam, gravity),
     }
-    return finish(
-        Mechanism(
-            name=name,
-            links=links,
-            joints=joints,
-            drives=(Drive("crank", "O2", speed=crank_speed, start_angle=start_angle),),
-            outputs=(Output("rocker_angle", "rocker6", OutputKind.ANGLE),),
-            gravity=(0.0, -gravity),
-            parameters=params,
-        )
+    output = Output("rocker_angle", "rocker6", OutputKind.ANGLE)
+    return crank_mechanism(
+        clr, links, joints, output, dims, linear_density=lam, crank_speed=crank_speed, start_angle=start_angle
     )

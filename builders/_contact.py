@@ -1,0 +1,206 @@
+"""The keywords that end every catalogue builder's signature, declared once.
+
+After its own dimensions and drives, every builder takes where its clearances are
+(``clearance_at``), their contact properties (``radial_clearance``, ``bearing_radius``,
+``restitution``, ``friction``, ``law``, ``material``), ``gravity`` and the mechanism's
+``name``. `ContactKeywords` declares them for the type checker (a builder ends with
+``**contact: Unpack[ContactKeywords]``); `contact_keywords` gives a builder their defaults
+and writes them into its signature one by one, so that `inspect.signature` (the command
+line, scenario files) and ``help`` list every keyword and an unknown one raises TypeError;
+`ClearanceFactory` turns them into `Clearance` records.
+"""
+
+from __future__ import annotations
+
+import functools
+import inspect
+from collections.abc import Callable, Sequence
+from typing import Any, ForwardRef, TypedDict, TypeVar, Unpack, cast
+
+from clearance.model import (
+    STEEL,
+    Clearance,
+    ContactLaw,
+    Joint,
+    JointType,
+    Material,
+    Mechanism,
+)
+
+__all__ = [
+    "DEFAULT_RADIAL_CLEARANCE",
+    "ContactKeywords",
+    "CONTACT_DEFAULTS",
+    "contact_keywords",
+    "ClearanceFactory",
+]
+
+DEFAULT_RADIAL_CLEARANCE = 0.1e-3
+"""Default radial clearance of the catalogue's mechanisms [m] (mid-range of 0.02-1 mm)."""
+
+
+class ContactKeywords(TypedDict, total=False):
+    """The keywords every catalogue builder takes after its own dimensions and drives.
+
+    Attributes:
+        clearance_at: joints with clearance (any of the builder's clearable joints); empty
+            for the ideal mechanism.
+        radial_clearance: c [m] at every clearance joint.
+        bearing_radius: R_B [m].
+        restitution: coefficient of restitution of every clearance joint.
+        friction: Coulomb friction coefficient of every clearance joint.
+        law: normal contact force law of every clearance joint.
+        material: journal and bearing material.
+        gravity: gravitational acceleration [m/s^2] along -y (0 for none).
+        name: mechanism name (default: the builder's name).
+    """
+
+    clearance_at: Sequence[str]
+    radial_clearance: float
+    bearing_radius: float
+    restitution: float
+    friction: float
+    law: ContactLaw
+    material: Material
+    gravity: float
+    name: str
+
+
+CONTACT_DEFAULTS: ContactKeywords = {
+    "radial_clearance": DEFAULT_RADIAL_CLEARANCE,
+    "bearing_radius": 0.010,
+    "restitution": 0.9,
+    "friction": 0.0,
+    "law": ContactLaw.LANKARANI_NIKRAVESH,
+    "material": STEEL,
+    "gravity": 0.0,
+}
+"""The catalogue's defaults of the contact keywords; ``clearance_at`` and ``name`` are each builder's own."""
+
+_Builder = TypeVar("_Builder", bound=Callable[..., Mechanism])
+
+
+def _annotation(hint: object) -> object:
+    """A `ContactKeywords` annotation as the builders' own are written (a string)."""
+    return hint.__forward_arg__ if isinstance(hint, ForwardRef) else hint
+
+
+def contact_keywords(**defaults: Unpack[ContactKeywords]) -> Callable[[_Builder], _Builder]:
+    """Decorate a builder that ends with ``**contact: Unpack[ContactKeywords]``.
+
+    The decorated builder's signature lists the contact keywords one by one after the
+    builder's own, with the defaults of `CONTACT_DEFAULTS` overridden by ``defaults``
+    (``clearance_at`` is required; ``name`` defaults to the builder's name). A call is
+    bound to that signature: an unknown keyword raises TypeError as for any function, and
+    the builder receives every keyword, given or defaulted.
+
+    Args:
+        defaults: the builder's own defaults of contact keywords; must include ``clearance_at``.
+
+    Returns:
+        The decorator.
+
+    Raises:
+        TypeError: ``clearance_at`` is not given, or the builder does not end with a
+            ``**`` parameter.
+    """
+    if "clearance_at" not in defaults:
+        raise TypeError("contact_keywords needs the builder's default clearance_at")
+
+    def decorate(build: _Builder) -> _Builder:
+        own = list(inspect.signature(build).parameters.values())
+        if not own or own[-1].kind is not inspect.Parameter.VAR_KEYWORD:
+            raise TypeError(f"{build.__name__} must end with **contact: Unpack[ContactKeywords]")
+        values: dict[str, Any] = {**CONTACT_DEFAULTS, "name": build.__name__, **defaults}
+        signature = inspect.signature(build).replace(
+            parameters=[
+                *own[:-1],
+                *(
+                    inspect.Parameter(
+                        key, inspect.Parameter.KEYWORD_ONLY, default=values[key], annotation=_annotation(t)
+                    )
+                    for key, t in ContactKeywords.__annotations__.items()
+                ),
+            ]
+        )
+
+        @functools.wraps(build)
+        def builder(*args: Any, **kwargs: Any) -> Mechanism:
+            try:
+                bound = signature.bind(*args, **kwargs)
+            except TypeError as e:
+                raise TypeError(f"{build.__name__}() {e}") from None
+            bound.apply_defaults()
+            return build(**bound.arguments)
+
+        # what `inspect.signature` reports; set through __dict__ as functools.update_wrapper sets attributes
+        builder.__dict__["__signature__"] = signature
+        return cast(_Builder, builder)
+
+    return decorate
+
+
+class ClearanceFactory:
+    """The contact keywords of one builder call: `Clearance` records by joint name, gravity, name.
+
+    Args:
+        clearable: joints that may carry a clearance (the others are driven or prismatic).
+        contact: the call's contact keywords, every one present (as a builder decorated
+            with `contact_keywords` receives them).
+
+    Raises:
+        ValueError: an unknown or non-clearable joint in ``clearance_at``, or a bad value.
+    """
+
+    def __init__(self, clearable: Sequence[str], contact: ContactKeywords) -> None:
+        clearance_at, law, material = contact["clearance_at"], contact["law"], contact["material"]
+        if isinstance(clearance_at, str):
+            raise ValueError(f"clearance_at must be a sequence of joint names (got the string {clearance_at!r})")
+        self.joints = tuple(clearance_at)
+        unknown = [j for j in self.joints if j not in clearable]
+        if unknown:
+            raise ValueError(f"clearance_at: unknown joint(s) {unknown}; expected any of {list(clearable)}")
+        if not isinstance(law, ContactLaw):
+            raise ValueError(f"law must be a ContactLaw (got {law!r})")
+        if not isinstance(material, Material):
+            raise ValueError(f"material must be a Material (got {material!r})")
+        self.template = Clearance(
+            radial_clearance=contact["radial_clearance"],
+            bearing_radius=contact["bearing_radius"],
+            bearing_material=material,
+            journal_material=material,
+            restitution=contact["restitution"],
+            friction=contact["friction"],
+            law=law,
+        )
+        self.gravity = contact["gravity"]
+        self.name = contact["name"]
+
+    def __call__(self, joint: str) -> Clearance | None:
+        """The clearance of ``joint``, or None for an ideal joint."""
+        return self.template if joint in self.joints else None
+
+    def revolute(self, name: str, link_a: str, point_a: str, link_b: str, point_b: str) -> Joint:
+        """A revolute joint, with clearance when ``name`` is in ``clearance_at``."""
+        return Joint(name, JointType.REVOLUTE, link_a, point_a, link_b, point_b, clearance=self(name))
+
+    def pin(self, name: str, link_a: str, link_b: str) -> Joint:
+        """A revolute joint between points named ``name`` of both links, with clearance as `revolute`."""
+        return self.revolute(name, link_a, name, link_b, name)
+
+    def parameters(self) -> dict[str, Any]:
+        """The contact keywords but ``name`` as JSON-friendly builder parameters."""
+        c = self.template
+        return {
+            "clearance_at": list(self.joints),
+            "radial_clearance": c.radial_clearance,
+            "bearing_radius": c.bearing_radius,
+            "restitution": c.restitution,
+            "friction": c.friction,
+            "law": c.law.value,
+            "material": {
+                "youngs_modulus": c.bearing_material.youngs_modulus,
+                "poisson_ratio": c.bearing_material.poisson_ratio,
+            },
+            "gravity": float(self.gravity),
+        }
