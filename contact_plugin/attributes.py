@@ -21,7 +21,7 @@ slot  field                  unit    meaning
 7     eccentricity           m       |e|, journal centre from bearing centre, in plane
 ====  =====================  ======  ====================================================
 
-Plugin state: `STATE_FIELDS`, 8 values per instance in ``mjData.plugin_state`` (part of
+Plugin state: `STATE_FIELDS`, 9 values per instance in ``mjData.plugin_state`` (part of
 ``mjSTATE_PLUGIN``); see the C file's header for their use.
 """
 
@@ -62,7 +62,8 @@ STATE_FIELDS: tuple[str, ...] = (
     "sample_time",
     "sample_penetration",
     "sample_rate",
-    "has_sample",
+    "previous_sample_rate",
+    "consecutive_samples",
     "in_contact",
     "approach_speed",
     "dissipated_work",
@@ -325,7 +326,7 @@ def state_address(model: mujoco.MjModel, name: str) -> int:
         name: the contact's name.
 
     Returns:
-        The index of `STATE_FIELDS[0]`; the block is 8 values long.
+        The index of `STATE_FIELDS[0]`; the block is 9 values long.
 
     Raises:
         ValueError: if the model has no such plugin instance.
