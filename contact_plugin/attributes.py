@@ -21,7 +21,7 @@ slot  field                  unit    meaning
 7     eccentricity           m       |e|, journal centre from bearing centre, in plane
 ====  =====================  ======  ====================================================
 
-Plugin state: `STATE_FIELDS`, 9 values per instance in ``mjData.plugin_state`` (part of
+Plugin state: `STATE_FIELDS`, 11 values per instance in ``mjData.plugin_state`` (part of
 ``mjSTATE_PLUGIN``); see the C file's header for their use.
 """
 
@@ -63,6 +63,8 @@ STATE_FIELDS: tuple[str, ...] = (
     "sample_penetration",
     "sample_rate",
     "previous_sample_rate",
+    "sample_tangential_velocity",
+    "previous_sample_tangential_velocity",
     "consecutive_samples",
     "in_contact",
     "approach_speed",
@@ -326,7 +328,7 @@ def state_address(model: mujoco.MjModel, name: str) -> int:
         name: the contact's name.
 
     Returns:
-        The index of `STATE_FIELDS[0]`; the block is 9 values long.
+        The index of `STATE_FIELDS[0]`; the block is 11 values long.
 
     Raises:
         ValueError: if the model has no such plugin instance.

@@ -43,13 +43,14 @@
 // the new velocities), which makes a sampled velocity lag its position by half a step (the
 // leapfrog reading: qvel_k is the velocity at t_k - h/2). Taken as it is, the damping term then
 // sees a stale rate and the first-impact peak force comes out high (+0.2..+1 % at 1 us, up to
-// +2..+6 % at 5 us). For those integrators the rate entering the law is advanced by half a step
-// with the rate changes of the last recorded steps (r_k the sampled rates, one step apart):
-//   delta_dot_law = r_k + (r_k - r_{k-1}) - (r_{k-1} - r_{k-2}) / 2
-// i.e. the next step's rate change extrapolated linearly from the last two (with one recorded
-// step only: r_k + (r_k - r_{k-1}) / 2; with none, or samples not one step apart: r_k), and the
-// onset rate is interpolated at theta + 1/2 instead of theta. It costs nothing per step (two more
-// numbers of state). RK4's states are synchronous, so it uses the rate as it is.
+// +2..+6 % at 5 us). For those integrators the velocities entering the laws (the penetration
+// rate and the tangential velocity) are advanced by half a step with the changes of the last
+// recorded steps (x_k the sampled values, one step apart):
+//   x_law = x_k + (x_k - x_{k-1}) - (x_{k-1} - x_{k-2}) / 2
+// i.e. the next step's change extrapolated linearly from the last two (with one recorded step
+// only: x_k + (x_k - x_{k-1}) / 2; with none, or samples not one step apart: x_k), and the onset
+// rate is interpolated at theta + 1/2 instead of theta. It costs nothing per step (four more
+// numbers of state). RK4's states are synchronous, so it uses the velocities as they are.
 // Measured on a point-mass impact (steel, K = 6.61e10 N/m^1.5, 0.15 kg, LN, 0.5..4 m/s, 7 phases
 // of the onset within the step), range of the first-impact peak force error at 1/2/3/5 us:
 //   c_e = 0.9  this scheme   -0.03..+0.02 / -0.22..+0.08 / -0.43..+0.18 / -1.16..+0.32 %
@@ -64,13 +65,21 @@
 // sampling of the peak between steps: RK4 at the same steps gives -0.06..0 / -0.28..0 /
 // -0.49..0 / -1.33..+0.04 % at four times the cost.
 //
-// State (nstate = 9 mjtNums per instance, part of mjSTATE_PLUGIN, so it travels with
+// Friction near rest. Ambrosio's ramp between v0 and v1 is stiff: an explicit step resolves it
+// only while h mu F_n / ((v1 - v0) m_t) < 2 (m_t the effective mass along t), i.e. below about
+// 1 kN at 1 us, mu = 0.1, m_t = 0.06 kg and the default v0, v1. In a harder impact that brings
+// the sliding to rest, v_t chatters around 0 by about h mu F_n / m_t per step instead of
+// settling in the ramp (the friction force stays bounded by mu F_n; the recorded dissipated
+// work then carries an error of the order of that chatter). Gross sliding is unaffected.
+//
+// State (nstate = 11 mjtNums per instance, part of mjSTATE_PLUGIN, so it travels with
 // mj_getState/mj_setState and through mujoco.rollout chunks):
 //   [0] time of the last recorded sample [s]    [1] delta there [m]
-//   [2] geometric delta_dot there [m/s]         [3] geometric delta_dot one step earlier [m/s]
-//   [4] recorded samples one step apart: 0, 1 or 2 (2: [3] is valid)
-//   [5] 1 while in an impact, else 0            [6] approach speed of that impact [m/s]
-//   [7] dissipated work so far [J]              [8] number of recorded steps
+//   [2] geometric delta_dot there [m/s]         [3] the same one step earlier [m/s]
+//   [4] geometric v_t there [m/s]               [5] the same one step earlier [m/s]
+//   [6] recorded samples one step apart: 0, 1 or 2 (2: [3] and [5] are valid)
+//   [7] 1 while in an impact, else 0            [8] approach speed of that impact [m/s]
+//   [9] dissipated work so far [J]              [10] number of recorded steps
 // The state is updated once per step, in `advance` (which MuJoCo calls once per mj_step, after
 // integration, whatever the integrator), from the force evaluation made at the step's start
 // state. Because `compute` runs several times per step under RK4 and kinematics in mjData
@@ -110,13 +119,14 @@
 #include <mujoco/mujoco.h>
 
 #define JB_NAME "clearance.journal_bearing"
-#define JB_NSTATE 9
+#define JB_NSTATE 11
 #define JB_NSENSOR 8
 #define JB_NCACHE 3  // RK4 evaluates the force at t, t + h/2 (twice) and t + h
 
 // state layout
 enum {
-  S_TIME = 0, S_DELTA, S_RATE, S_RATE2, S_HAVE, S_CONTACT, S_VIN, S_WORK, S_NSTEP
+  S_TIME = 0, S_DELTA, S_RATE, S_RATE2, S_VT, S_VT2, S_HAVE, S_CONTACT, S_VIN, S_WORK,
+  S_NSTEP
 };
 
 // contact laws, in the order of clearance.model.ContactLaw
@@ -140,6 +150,7 @@ typedef struct {
   mjtNum delta;      // penetration [m]
   mjtNum rate_geo;   // geometric penetration rate [m/s]
   mjtNum rate;       // rate entering the law [m/s]
+  mjtNum vt_geo;     // geometric tangential velocity [m/s]
   mjtNum vin;        // approach speed [m/s] (0 out of contact)
   mjtNum fn;         // normal force [N]
   mjtNum ft;         // tangential force [N]
@@ -366,6 +377,20 @@ static int sample_is_recent(const mjModel* m, const mjData* d, const mjtNum* s) 
   return s[S_HAVE] != 0 && age > 0 && age <= 2 * m->opt.timestep * (1 + 1e-9);
 }
 
+// a sampled velocity x advanced by half a step, from the samples x1, x2 one and two steps back
+// (semi-implicit integrators only; see "In-step treatment")
+static mjtNum half_step_ahead(const mjModel* m, const mjData* d, const mjtNum* s,
+                              mjtNum x, mjtNum x1, mjtNum x2) {
+  if (!semi_implicit(m) || !sample_is_last_step(m, d, s)) {
+    return x;
+  }
+  mjtNum change = x - x1;  // h times the last step's acceleration
+  if (s[S_HAVE] >= 2) {
+    change += change - (x1 - x2);  // extrapolated to this step
+  }
+  return x + 0.5 * change;
+}
+
 // normal force of the configured law, the operations of laws.py
 static mjtNum normal_force(const jbData* c, mjtNum delta, mjtNum rate, mjtNum vin, mjtNum* fel) {
   *fel = 0;
@@ -446,19 +471,13 @@ static void evaluate(const mjModel* m, const mjData* d, const jbData* c, const m
   mju_add3(vpj, vj + 3, wj);
   mju_add3(vpb, vb + 3, wb);
   mju_sub3(vp, vpj, vpb);
-  mjtNum vt = mju_dot3(ev->tangent, vp);
+  mjtNum vt_geo = mju_dot3(ev->tangent, vp);
 
-  // rate entering the law: half a step ahead for semi-implicit integrators (file header)
+  // velocities entering the laws: half a step ahead for semi-implicit integrators
   mjtNum delta = ecc - c->clearance;
   int last_step = sample_is_last_step(m, d, s);
-  mjtNum rate = rate_geo;
-  if (semi_implicit(m) && last_step) {
-    mjtNum change = rate_geo - s[S_RATE];  // h times the last step's acceleration
-    if (s[S_HAVE] >= 2) {
-      change += change - (s[S_RATE] - s[S_RATE2]);  // extrapolated to this step
-    }
-    rate = rate_geo + 0.5 * change;
-  }
+  mjtNum rate = half_step_ahead(m, d, s, rate_geo, s[S_RATE], s[S_RATE2]);
+  mjtNum vt = half_step_ahead(m, d, s, vt_geo, s[S_VT], s[S_VT2]);
 
   // approach speed: kept during an impact, located at the crossing at onset
   mjtNum vin = 0;
@@ -484,6 +503,7 @@ static void evaluate(const mjModel* m, const mjData* d, const jbData* c, const m
   ev->delta = delta;
   ev->rate_geo = rate_geo;
   ev->rate = rate;
+  ev->vt_geo = vt_geo;
   ev->vin = vin;
   ev->fn = fn;
   ev->ft = ft;
@@ -638,10 +658,12 @@ static void jb_advance(const mjModel* m, mjData* d, int instance) {
     s[S_CONTACT] = ev->delta > 0 ? 1.0 : 0.0;
     s[S_VIN] = ev->delta > 0 ? ev->vin : 0.0;
     s[S_RATE2] = consecutive ? s[S_RATE] : 0.0;
+    s[S_VT2] = consecutive ? s[S_VT] : 0.0;
     s[S_HAVE] = consecutive ? 2.0 : 1.0;
     s[S_TIME] = ev->time;
     s[S_DELTA] = ev->delta;
     s[S_RATE] = ev->rate_geo;
+    s[S_VT] = ev->vt_geo;
     s[S_NSTEP] += 1.0;
   }
   clear_cache(c);
