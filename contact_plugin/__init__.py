@@ -33,12 +33,12 @@ import threading
 from pathlib import Path
 
 __all__ = [
-    "PLUGIN_NAME",
     "LIBRARY_FILE",
+    "PLUGIN_NAME",
     "PluginUnavailableError",
+    "is_available",
     "library_path",
     "load",
-    "is_available",
     "require",
 ]
 

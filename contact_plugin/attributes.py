@@ -39,8 +39,8 @@ from clearance.model import Clearance, ContactLaw
 __all__ = [
     "SENSOR_FIELDS",
     "STATE_FIELDS",
-    "add_journal_bearing",
     "add_for_clearance",
+    "add_journal_bearing",
     "sensor_address",
     "sensor_offsets",
     "state_address",
