@@ -88,15 +88,16 @@ def load() -> None:
     """
     global _loaded
     path = library_path()
-    if path is None:
+    if path is None or _loaded == path:
         return
-    with _lock:
-        if _loaded == path:
-            return
-        import mujoco  # during `import mujoco`, the partly initialised module: enough here
+    # Outside the lock: a first `import mujoco` calls this function again (entry point), and
+    # during `import mujoco` the partly initialised module is returned, which is enough here.
+    import mujoco
 
-        mujoco.mj_loadPluginLibrary(str(path))
-        _loaded = path
+    with _lock:
+        if _loaded != path:
+            mujoco.mj_loadPluginLibrary(str(path))
+            _loaded = path
 
 
 def is_available() -> bool:

@@ -395,6 +395,15 @@ def test_import_is_cheap() -> None:
     assert out.stdout.strip() == "[]"
 
 
+def test_loading_before_mujoco_is_imported() -> None:
+    # load() imports mujoco, whose entry point calls load() again: no deadlock, one load.
+    code = ("import clearance.contact_plugin as cp; cp.load(); cp.load(); "
+            "print(cp.is_available() == (cp.library_path() is not None))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                         check=True, timeout=120)
+    assert out.stdout.strip() == "True"
+
+
 _CHILD = textwrap.dedent("""
     import mujoco
     model = mujoco.MjModel.from_xml_string(XML)
