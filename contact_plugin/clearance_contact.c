@@ -57,7 +57,7 @@
 //              rate as is    +0.17..+0.31 / +0.33..+0.68 / +0.41..+1.12 / +0.35..+2.12 %
 //   c_e = 0.5  this scheme   -0.07..+0.01 / -0.27..+0.04 / -0.60..-0.01 / -2.85..-0.01 %
 //              rate as is    +0.59..+0.96 / +1.12..+2.01 / +1.61..+3.08 / +2.43..+5.77 %
-// with restitution errors of at most 0.01/0.04/0.11/0.33 % (rate as is: 0.02/0.02/0.06/0.26 %).
+// with restitution errors of at most 0.01/0.04/0.11/0.33 % (rate as is: 0.00/0.02/0.06/0.26 %).
 // So a first impact stays within 1 % up to 3 us instead of 1 us. Two cheaper variants were
 // worse: the half-step advance with the last rate change only (same peaks, restitution errors
 // up to 1.65 % at 5 us) and evaluating the whole force at a predicted mid-step position
