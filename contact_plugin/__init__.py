@@ -11,6 +11,11 @@ impact, dissipated work, last sample) lives in ``mjData.plugin_state``, so it is
 ``mjSTATE_PLUGIN`` and travels through chunked and threaded ``mujoco.rollout`` runs. A plugin
 sensor reports 8 values per joint (`clearance.contact_plugin.attributes.SENSOR_FIELDS`).
 
+Cost (measured with mujoco.rollout on one thread, journal and bearing with three planar dofs
+each or a fixed bearing, 2 us steps, implicitfast): 435k-500k steps/s against 560k-600k for the
+same bodies with no contact, i.e. about 0.3 us per step per joint out of contact and 0.6 us in
+sliding contact with friction.
+
 Installation: the library is compiled by ``pip install`` (``setup.py``, an optional extension
 built against the mujoco wheel of the build environment). Without a C compiler the package
 installs all the same, without the library: `is_available` is then False and asking for the
