@@ -50,9 +50,7 @@ __all__ = [
 PLUGIN_NAME = "clearance.journal_bearing"
 """Name under which the library registers the plugin with MuJoCo."""
 
-LIBRARY_FILE = "libclearance_journal_bearing" + {"darwin": ".dylib", "win32": ".dll"}.get(
-    sys.platform, ".so"
-)
+LIBRARY_FILE = "libclearance_journal_bearing" + {"darwin": ".dylib", "win32": ".dll"}.get(sys.platform, ".so")
 """File name of the built plugin library, next to this module (see setup.py)."""
 
 _lock = threading.Lock()
@@ -116,7 +114,7 @@ def is_available() -> bool:
         return False
     try:
         load()
-    except Exception:  # noqa: BLE001 - a library that fails to load is not available
+    except Exception:  # a library that fails to load is not available
         return False
     return _loaded == path
 

@@ -85,29 +85,21 @@ _DISSIPATIVE = (
 def _number(joint: str, attribute: str, value: Any, expected: str, ok: Any) -> float:
     """``value`` as a float if finite and ``ok(value)``, else a ValueError saying what was expected."""
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(
-            f"journal-bearing contact '{joint}': {attribute} must be a number {expected} "
-            f"(got {value!r})"
-        )
+        raise ValueError(f"journal-bearing contact '{joint}': {attribute} must be a number {expected} (got {value!r})")
     v = float(value)
     if not (math.isfinite(v) and ok(v)):
         raise ValueError(
-            f"journal-bearing contact '{joint}': {attribute} must be finite and {expected} "
-            f"(got {value!r})"
+            f"journal-bearing contact '{joint}': {attribute} must be finite and {expected} (got {value!r})"
         )
     return v
 
 
 def _site(spec: mujoco.MjSpec, joint: str, attribute: str, name: Any) -> mujoco.MjsSite:
     if not isinstance(name, str) or not name:
-        raise ValueError(
-            f"journal-bearing contact '{joint}': {attribute} must be a site name (got {name!r})"
-        )
+        raise ValueError(f"journal-bearing contact '{joint}': {attribute} must be a site name (got {name!r})")
     site = spec.site(name)
     if site is None:
-        raise ValueError(
-            f"journal-bearing contact '{joint}': {attribute} = {name!r} is not a site of the spec"
-        )
+        raise ValueError(f"journal-bearing contact '{joint}': {attribute} = {name!r} is not a site of the spec")
     return site
 
 
@@ -170,8 +162,7 @@ def add_journal_bearing(
     j = name
     if any(p.name == name for p in spec.plugins) or spec.sensor(name) is not None:
         raise ValueError(
-            f"journal-bearing contact '{j}': name {name!r} is already used by a plugin instance "
-            "or a sensor of the spec"
+            f"journal-bearing contact '{j}': name {name!r} is already used by a plugin instance or a sensor of the spec"
         )
     journal = _site(spec, j, "journal_site", journal_site)
     bearing = _site(spec, j, "bearing_site", bearing_site)
@@ -196,9 +187,7 @@ def add_journal_bearing(
         "exponent": _number(j, "exponent", exponent, "> 0", lambda v: v > 0),
         "friction": _number(j, "friction", friction, ">= 0", lambda v: v >= 0),
         "v0": _number(j, "v0", v0, ">= 0 [m/s]", lambda v: v >= 0),
-        "min_approach_speed": _number(
-            j, "min_approach_speed", min_approach_speed, "> 0 [m/s]", lambda v: v > 0
-        ),
+        "min_approach_speed": _number(j, "min_approach_speed", min_approach_speed, "> 0 [m/s]", lambda v: v > 0),
     }
     config["v1"] = _number(j, "v1", v1, f"> v0 = {config['v0']} [m/s]", lambda v: v > config["v0"])
 
@@ -266,11 +255,21 @@ def add_for_clearance(
     """
     law = clearance.law
     add_journal_bearing(
-        spec, name=name, journal_site=journal_site, bearing_site=bearing_site,
-        clearance=clearance.radial_clearance, journal_radius=clearance.journal_radius, law=law,
-        stiffness=laws.bearing_stiffness(clearance), exponent=1.5,
+        spec,
+        name=name,
+        journal_site=journal_site,
+        bearing_site=bearing_site,
+        clearance=clearance.radial_clearance,
+        journal_radius=clearance.journal_radius,
+        law=law,
+        stiffness=laws.bearing_stiffness(clearance),
+        exponent=1.5,
         restitution=clearance.restitution,
-        c_max=c_max, d_max=d_max, friction=clearance.friction, v0=v0, v1=v1,
+        c_max=c_max,
+        d_max=d_max,
+        friction=clearance.friction,
+        v0=v0,
+        v1=v1,
         min_approach_speed=min_approach_speed,
     )
 
@@ -296,9 +295,7 @@ def sensor_address(model: mujoco.MjModel, name: str) -> int:
         ValueError: if the model has no such plugin sensor.
     """
     i = _id(model, mujoco.mjtObj.mjOBJ_SENSOR, name, "sensor")
-    if model.sensor_type[i] != mujoco.mjtSensor.mjSENS_PLUGIN or model.sensor_dim[i] != len(
-        SENSOR_FIELDS
-    ):
+    if model.sensor_type[i] != mujoco.mjtSensor.mjSENS_PLUGIN or model.sensor_dim[i] != len(SENSOR_FIELDS):
         raise ValueError(f"sensor {name!r} is not a journal-bearing contact sensor")
     return int(model.sensor_adr[i])
 

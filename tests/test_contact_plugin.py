@@ -60,9 +60,14 @@ def _law_parameters(law: ContactLaw) -> dict[str, float]:
 
 
 def _spec(
-    law: ContactLaw = LN, *, timestep: float = 1e-6, friction: float = 0.0,
+    law: ContactLaw = LN,
+    *,
+    timestep: float = 1e-6,
+    friction: float = 0.0,
     integrator: mujoco.mjtIntegrator = mujoco.mjtIntegrator.mjINT_EULER,
-    moving_bearing: bool = False, frame_quat: tuple[float, ...] = (1, 0, 0, 0), **law_kw: float,
+    moving_bearing: bool = False,
+    frame_quat: tuple[float, ...] = (1, 0, 0, 0),
+    **law_kw: float,
 ) -> mujoco.MjSpec:
     """A journal (slide x, slide y, hinge z) in a bearing, both in one (rotated) frame.
 
@@ -79,10 +84,12 @@ def _spec(
     for name in ("bearing", "journal"):
         body = frame.add_body(name=name)
         if name == "journal" or moving_bearing:
-            for joint, kind, axis in (("x", "SLIDE", [1, 0, 0]), ("y", "SLIDE", [0, 1, 0]),
-                                      ("spin", "HINGE", [0, 0, 1])):
-                body.add_joint(name=f"{name}_{joint}", axis=axis,
-                               type=getattr(mujoco.mjtJoint, f"mjJNT_{kind}"))
+            for joint, kind, axis in (
+                ("x", "SLIDE", [1, 0, 0]),
+                ("y", "SLIDE", [0, 1, 0]),
+                ("spin", "HINGE", [0, 0, 1]),
+            ):
+                body.add_joint(name=f"{name}_{joint}", axis=axis, type=getattr(mujoco.mjtJoint, f"mjJNT_{kind}"))
         body.explicitinertial = True
         body.mass = MASS
         body.inertia = [INERTIA] * 3
@@ -90,8 +97,18 @@ def _spec(
         bodies[name] = body
     parameters = {**_law_parameters(law), **law_kw}
     attributes.add_journal_bearing(
-        spec, name="joint", journal_site="journal", bearing_site="bearing", clearance=C,
-        journal_radius=R_J, law=law, stiffness=K, friction=friction, v0=V0, v1=V1, **parameters,
+        spec,
+        name="joint",
+        journal_site="journal",
+        bearing_site="bearing",
+        clearance=C,
+        journal_radius=R_J,
+        law=law,
+        stiffness=K,
+        friction=friction,
+        v0=V0,
+        v1=V1,
+        **parameters,
     )
     return spec
 
@@ -121,13 +138,10 @@ def test_compiled_laws_equal_laws_py(law: ContactLaw) -> None:
     rng = np.random.default_rng(7)
     params = _law_parameters(law)
     for _ in range(60):
-        delta = rng.uniform(-5e-6, 4e-5) if law is not ContactLaw.IMPACT else rng.uniform(
-            -5e-6, 2 * IMPACT_D_MAX
-        )
+        delta = rng.uniform(-5e-6, 4e-5) if law is not ContactLaw.IMPACT else rng.uniform(-5e-6, 2 * IMPACT_D_MAX)
         rate, approach = rng.uniform(-4, 4), rng.uniform(5e-4, 3)  # floor crossed sometimes
         # Sliding (spinning journal) or inside Ambrósio's ramp (no spin: v_t = qvel y).
-        spin, vt = rng.choice([(0.0, rng.uniform(-3e-3, 3e-3)), (0.0, 0.0),
-                               (rng.uniform(-50, 50), rng.uniform(-2, 2))])
+        spin, vt = rng.choice([(0.0, rng.uniform(-3e-3, 3e-3)), (0.0, 0.0), (rng.uniform(-50, 50), rng.uniform(-2, 2))])
         mujoco.mj_resetData(model, data)
         # Journal on the bearing's x axis: n = x and t = y, so δ̇ = qvel x and v_t = qvel y +
         # spin R_J up to the last bit of MuJoCo's velocity transforms.
@@ -141,8 +155,9 @@ def test_compiled_laws_equal_laws_py(law: ContactLaw) -> None:
         assert d == pytest.approx(delta, abs=1e-18)  # one rounding of c + δ (ulp(5e-4) = 1e-19)
         expected_vin = max(approach, laws.MIN_APPROACH_SPEED) if d > 0 else 0.0
         assert vin == expected_vin  # kept from the state, floored
-        expected = laws.normal_force(law, d, dd, max(vin, laws.MIN_APPROACH_SPEED),
-                                     stiffness=K, **{"restitution": 1.0, **params})
+        expected = laws.normal_force(
+            law, d, dd, max(vin, laws.MIN_APPROACH_SPEED), stiffness=K, **{"restitution": 1.0, **params}
+        )
         # rtol 1e-12: the same operations in the same order; only pow() may differ in its
         # last bit between the C library and NumPy.
         assert fn == pytest.approx(expected, rel=1e-12, abs=0.0)
@@ -158,8 +173,7 @@ def test_compiled_laws_equal_laws_py(law: ContactLaw) -> None:
 def test_geometry_and_applied_forces(moving_bearing: bool) -> None:
     # A rotated frame: the joint's plane is the bearing site's x-y plane, not the world's.
     quat = np.array([np.cos(0.3), np.sin(0.3) * 0.6, 0.0, np.sin(0.3) * 0.8])
-    model = _spec(LN, friction=0.2, moving_bearing=moving_bearing,
-                  frame_quat=tuple(quat)).compile()
+    model = _spec(LN, friction=0.2, moving_bearing=moving_bearing, frame_quat=tuple(quat)).compile()
     data = mujoco.MjData(model)
     y = attributes.sensor_address(model, "joint")
     rng = np.random.default_rng(3)
@@ -233,20 +247,21 @@ def _normal_impact(model: mujoco.MjModel, speed: float, phase: float, nstep: int
 
 
 @needs_plugin
-@pytest.mark.parametrize(("law", "timestep", "peak_tol"), [
-    # 0.5 % at 1 us is the brief's target; measured -0.03..+0.02 % (C file header).
-    (LN, 1e-6, 5e-3),
-    (ContactLaw.FLORES, 1e-6, 5e-3),
-    (ContactLaw.HERTZ, 1e-6, 5e-3),
-    # The C file claims first impacts within 1 % up to 3 us; measured -0.43..+0.18 % at 4 m/s.
-    (LN, 3e-6, 1e-2),
-])
-def test_impact_matches_point_mass_reference(law: ContactLaw, timestep: float,
-                                             peak_tol: float) -> None:
+@pytest.mark.parametrize(
+    ("law", "timestep", "peak_tol"),
+    [
+        # 0.5 % at 1 us is the brief's target; measured -0.03..+0.02 % (C file header).
+        (LN, 1e-6, 5e-3),
+        (ContactLaw.FLORES, 1e-6, 5e-3),
+        (ContactLaw.HERTZ, 1e-6, 5e-3),
+        # The C file claims first impacts within 1 % up to 3 us; measured -0.43..+0.18 % at 4 m/s.
+        (LN, 3e-6, 1e-2),
+    ],
+)
+def test_impact_matches_point_mass_reference(law: ContactLaw, timestep: float, peak_tol: float) -> None:
     speed = 2.0
     params = _law_parameters(law)
-    ref = law_impact(law, mass=MASS, speed=speed, stiffness=K,
-                     restitution=params.get("restitution", 1.0))
+    ref = law_impact(law, mass=MASS, speed=speed, stiffness=K, restitution=params.get("restitution", 1.0))
     model = _spec(law, timestep=timestep).compile()
     state, sensors = _normal_impact(model, speed, 0.37, int(1.5 * ref.duration / timestep))
     y = attributes.sensor_offsets(model, "joint")
@@ -264,8 +279,9 @@ def test_impact_matches_point_mass_reference(law: ContactLaw, timestep: float,
 # ---------------------------------------------------------------- state through rollouts
 
 
-def _bouncing(integrator: mujoco.mjtIntegrator = mujoco.mjtIntegrator.mjINT_EULER,
-              friction: float = 0.1) -> tuple[mujoco.MjModel, np.ndarray]:
+def _bouncing(
+    integrator: mujoco.mjtIntegrator = mujoco.mjtIntegrator.mjINT_EULER, friction: float = 0.1
+) -> tuple[mujoco.MjModel, np.ndarray]:
     """A journal bouncing around its bearing (several impacts in 3 ms), and its start state."""
     model = _spec(LN, friction=friction, integrator=integrator).compile()
     data = mujoco.MjData(model)
@@ -293,8 +309,7 @@ def test_chunked_and_threaded_rollouts_are_bitwise_equal() -> None:
     starts = np.repeat(start[None], 4, axis=0)
     starts[:, 1 + model.nq : 1 + model.nq + 2] *= np.array([1.0, 0.9, 1.1, 1.2])[:, None]
     one, one_y = rollout.rollout(model, data, starts, nstep=1500)
-    two, two_y = rollout.rollout(model, [mujoco.MjData(model) for _ in range(2)], starts,
-                                 nstep=1500)
+    two, two_y = rollout.rollout(model, [mujoco.MjData(model) for _ in range(2)], starts, nstep=1500)
     np.testing.assert_array_equal(one, two)
     np.testing.assert_array_equal(one_y, two_y)
     mujoco.mj_setState(model, data, start, FULL)
@@ -305,14 +320,15 @@ def test_chunked_and_threaded_rollouts_are_bitwise_equal() -> None:
 
 
 @needs_plugin
-@pytest.mark.parametrize("integrator", [mujoco.mjtIntegrator.mjINT_EULER,
-                                        mujoco.mjtIntegrator.mjINT_IMPLICITFAST,
-                                        mujoco.mjtIntegrator.mjINT_RK4])
+@pytest.mark.parametrize(
+    "integrator",
+    [mujoco.mjtIntegrator.mjINT_EULER, mujoco.mjtIntegrator.mjINT_IMPLICITFAST, mujoco.mjtIntegrator.mjINT_RK4],
+)
 def test_state_is_updated_once_per_step(integrator: mujoco.mjtIntegrator) -> None:
     model, start = _bouncing(integrator, friction=0.0)
     nstep = 3000
     state, sensors = rollout.rollout(model, mujoco.MjData(model), start, nstep=nstep)
-    plugin = state[0, -1, -len(attributes.STATE_FIELDS):]
+    plugin = state[0, -1, -len(attributes.STATE_FIELDS) :]
     assert plugin[S["steps"]] == nstep  # RK4 calls compute 4 times a step, advance once
     # The dissipated work is the sum of h * (F_n - K δⁿ) δ̇ over the force evaluations made at
     # each step's start state, which are exactly what the sensor recorded. Stage evaluations
@@ -339,8 +355,7 @@ def _impact_energy(timestep: float, law: ContactLaw) -> tuple[float, float]:
     v_start = np.array([2.0, 0.5, 30.0])
     data.qpos[0] = C - v_start[0] * timestep * 0.37
     data.qvel[:3] = v_start
-    state, sensors = rollout.rollout(model, data, _full_state(model, data),
-                                     nstep=int(1.5e-4 / timestep))
+    state, sensors = rollout.rollout(model, data, _full_state(model, data), nstep=int(1.5e-4 / timestep))
     qvel = np.vstack([v_start, state[0, :, 1 + model.nq : 1 + model.nq + 3]])
     # Semi-implicit Euler's velocities sit half a step off its positions: the velocity at a
     # step's start time is the mean of the velocities before and after that step.
@@ -352,8 +367,7 @@ def _impact_energy(timestep: float, law: ContactLaw) -> tuple[float, float]:
     # of the step's dissipation h (F_n - K δⁿ) δ̇ has taken place.
     d = np.maximum(y[:, Y["penetration"]], 0.0)
     power = (y[:, Y["normal_force"]] - K * d**1.5) * y[:, Y["penetration_rate"]]
-    energy = (0.5 * (v**2) @ m + y[:, Y["potential_energy"]] + y[:, Y["dissipated_work"]]
-              + 0.5 * timestep * power)
+    energy = 0.5 * (v**2) @ m + y[:, Y["potential_energy"]] + y[:, Y["dissipated_work"]] + 0.5 * timestep * power
     assert y[-1, Y["penetration"]] < 0  # separated
     end = 0.5 * m @ qvel[-1] ** 2 + state[0, -1, -len(attributes.STATE_FIELDS) + S["dissipated_work"]]
     return float(np.abs(energy / e0 - 1).max()), float(abs(end / e0 - 1))
@@ -388,19 +402,22 @@ def test_entry_point_is_registered() -> None:
 def test_import_is_cheap() -> None:
     # `import mujoco` imports this package through the entry point: it must not drag in the
     # heavy parts of clearance, scipy or matplotlib, nor import mujoco itself.
-    code = ("import sys, clearance.contact_plugin; "
-            "print(sorted(m for m in ('scipy', 'matplotlib', 'mujoco', 'numpy', "
-            "'clearance.contact_calibration', 'clearance.simulation') if m in sys.modules))")
+    code = (
+        "import sys, clearance.contact_plugin; "
+        "print(sorted(m for m in ('scipy', 'matplotlib', 'mujoco', 'numpy', "
+        "'clearance.contact_calibration', 'clearance.simulation') if m in sys.modules))"
+    )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]"
 
 
 def test_loading_before_mujoco_is_imported() -> None:
     # load() imports mujoco, whose entry point calls load() again: no deadlock, one load.
-    code = ("import clearance.contact_plugin as cp; cp.load(); cp.load(); "
-            "print(cp.is_available() == (cp.library_path() is not None))")
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
-                         check=True, timeout=120)
+    code = (
+        "import clearance.contact_plugin as cp; cp.load(); cp.load(); "
+        "print(cp.is_available() == (cp.library_path() is not None))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, timeout=120)
     assert out.stdout.strip() == "True"
 
 
@@ -431,9 +448,17 @@ def test_spawned_process_that_only_imports_mujoco_can_compile() -> None:
 def test_spec_round_trips_through_xml() -> None:
     spec = mujoco.MjSpec.from_string(f"<mujoco>{_BODIES}</mujoco>")
     attributes.add_journal_bearing(
-        spec, name="impact", journal_site="journal", bearing_site="bearing", clearance=C,
-        journal_radius=R_J, law=ContactLaw.IMPACT, stiffness=K, c_max=IMPACT_C_MAX,
-        d_max=IMPACT_D_MAX, friction=0.1,
+        spec,
+        name="impact",
+        journal_site="journal",
+        bearing_site="bearing",
+        clearance=C,
+        journal_radius=R_J,
+        law=ContactLaw.IMPACT,
+        stiffness=K,
+        c_max=IMPACT_C_MAX,
+        d_max=IMPACT_D_MAX,
+        friction=0.1,
     )
     model = spec.compile()
     again = mujoco.MjSpec.from_string(spec.to_xml()).compile()
@@ -450,22 +475,31 @@ _BODIES = """
     <body name="journal"><joint type="slide" axis="1 0 0"/><site name="journal"/>
       <inertial pos="0 0 0" mass="0.15" diaginertia="1e-5 1e-5 1e-5"/></body>
   </worldbody>"""
-_XML = """
+_XML = (
+    """
 <mujoco>
   <extension><plugin plugin="clearance.journal_bearing"><instance name="joint">
     {config}
-  </instance></plugin></extension>""" + _BODIES + """
+  </instance></plugin></extension>"""
+    + _BODIES
+    + """
   <sensor><plugin name="joint" instance="joint"/></sensor>
 </mujoco>"""
-_GOOD = {"journal_site": "journal", "bearing_site": "bearing", "clearance": "5e-4",
-         "journal_radius": "9.5e-3", "law": "lankarani_nikravesh", "stiffness": "6.61e10",
-         "restitution": "0.9"}
+)
+_GOOD = {
+    "journal_site": "journal",
+    "bearing_site": "bearing",
+    "clearance": "5e-4",
+    "journal_radius": "9.5e-3",
+    "law": "lankarani_nikravesh",
+    "stiffness": "6.61e10",
+    "restitution": "0.9",
+}
 
 
 def _xml(**config: str) -> str:
     items = {**_GOOD, **config}
-    return _XML.format(config="".join(f'<config key="{k}" value="{v}"/>'
-                                      for k, v in items.items() if v is not None))
+    return _XML.format(config="".join(f'<config key="{k}" value="{v}"/>' for k, v in items.items() if v is not None))
 
 
 @needs_plugin
@@ -479,17 +513,28 @@ def test_c_defaults_and_law_codes() -> None:
     fn, ft, d, dd, vin = data.sensordata[:5]
     assert vin == laws.MIN_APPROACH_SPEED
     assert ft == 0.0
-    assert fn == pytest.approx(laws.lankarani_nikravesh(d, dd, vin, stiffness=K, restitution=0.9),
-                               rel=1e-12)  # same operations, as above
+    assert fn == pytest.approx(
+        laws.lankarani_nikravesh(d, dd, vin, stiffness=K, restitution=0.9), rel=1e-12
+    )  # same operations, as above
 
 
 @needs_plugin
-@pytest.mark.parametrize("config", [
-    {"clearance": "-1e-4"}, {"stiffness": "0"}, {"law": "bogus"}, {"law": "7"},
-    {"bearing_site": "missing"}, {"restitution": None}, {"restitution": "1.5"},
-    {"journal_radius": "nan"}, {"v0": "1e-3", "v1": "1e-4"}, {"clearance": "5e-4x"},
-    {"bearing_site": "journal"},
-])
+@pytest.mark.parametrize(
+    "config",
+    [
+        {"clearance": "-1e-4"},
+        {"stiffness": "0"},
+        {"law": "bogus"},
+        {"law": "7"},
+        {"bearing_site": "missing"},
+        {"restitution": None},
+        {"restitution": "1.5"},
+        {"journal_radius": "nan"},
+        {"v0": "1e-3", "v1": "1e-4"},
+        {"clearance": "5e-4x"},
+        {"bearing_site": "journal"},
+    ],
+)
 def test_c_init_refuses_bad_config_safely(config: dict[str, str | None]) -> None:
     # Hand-written XML bypasses the Python checks: the C init refuses, MuJoCo raises.
     with pytest.raises(ValueError, match="plugin->init failed"):
@@ -499,32 +544,44 @@ def test_c_init_refuses_bad_config_safely(config: dict[str, str | None]) -> None
 # ---------------------------------------------------------------- Python validation
 
 
-@pytest.mark.parametrize(("change", "message"), [
-    ({"clearance": -1e-4}, "'joint': clearance must be finite and > 0 [m] (got -0.0001)"),
-    ({"clearance": float("nan")}, "clearance must be finite and > 0 [m] (got nan)"),
-    ({"journal_radius": float("inf")}, "journal_radius must be finite and > 0 [m] (got inf)"),
-    ({"stiffness": -1.0}, "stiffness must be finite and > 0 [N/m^n] (got -1.0)"),
-    ({"stiffness": "1e10"}, "stiffness must be a number > 0 [N/m^n] (got '1e10')"),
-    ({"exponent": 0}, "exponent must be finite and > 0 (got 0)"),
-    ({"law": "lankarani_nikravesh"}, "law must be a ContactLaw member (got 'lankarani_nikravesh')"),
-    ({"journal_site": "nowhere"}, "journal_site = 'nowhere' is not a site of the spec"),
-    ({"bearing_site": "journal"}, "are on the same body 'journal'"),
-    ({"restitution": None}, "law LANKARANI_NIKRAVESH needs restitution"),
-    ({"restitution": 1.2}, "restitution must be finite and in [0, 1] (got 1.2)"),
-    ({"law": ContactLaw.FLORES, "restitution": 0.0}, "restitution must be in (0, 1] (got 0.0)"),
-    ({"law": ContactLaw.IMPACT}, "law IMPACT needs c_max [N s/m] and d_max [m]"),
-    ({"c_max": 1e4}, "used by law IMPACT only, not LANKARANI_NIKRAVESH"),
-    ({"friction": -0.1}, "friction must be finite and >= 0 (got -0.1)"),
-    ({"v0": 2e-3}, "v1 must be finite and > v0 = 0.002 [m/s] (got 0.001)"),
-    ({"min_approach_speed": 0.0}, "min_approach_speed must be finite and > 0 [m/s] (got 0.0)"),
-    ({"friction": True}, "friction must be a number >= 0 (got True)"),
-])
+@pytest.mark.parametrize(
+    ("change", "message"),
+    [
+        ({"clearance": -1e-4}, "'joint': clearance must be finite and > 0 [m] (got -0.0001)"),
+        ({"clearance": float("nan")}, "clearance must be finite and > 0 [m] (got nan)"),
+        ({"journal_radius": float("inf")}, "journal_radius must be finite and > 0 [m] (got inf)"),
+        ({"stiffness": -1.0}, "stiffness must be finite and > 0 [N/m^n] (got -1.0)"),
+        ({"stiffness": "1e10"}, "stiffness must be a number > 0 [N/m^n] (got '1e10')"),
+        ({"exponent": 0}, "exponent must be finite and > 0 (got 0)"),
+        ({"law": "lankarani_nikravesh"}, "law must be a ContactLaw member (got 'lankarani_nikravesh')"),
+        ({"journal_site": "nowhere"}, "journal_site = 'nowhere' is not a site of the spec"),
+        ({"bearing_site": "journal"}, "are on the same body 'journal'"),
+        ({"restitution": None}, "law LANKARANI_NIKRAVESH needs restitution"),
+        ({"restitution": 1.2}, "restitution must be finite and in [0, 1] (got 1.2)"),
+        ({"law": ContactLaw.FLORES, "restitution": 0.0}, "restitution must be in (0, 1] (got 0.0)"),
+        ({"law": ContactLaw.IMPACT}, "law IMPACT needs c_max [N s/m] and d_max [m]"),
+        ({"c_max": 1e4}, "used by law IMPACT only, not LANKARANI_NIKRAVESH"),
+        ({"friction": -0.1}, "friction must be finite and >= 0 (got -0.1)"),
+        ({"v0": 2e-3}, "v1 must be finite and > v0 = 0.002 [m/s] (got 0.001)"),
+        ({"min_approach_speed": 0.0}, "min_approach_speed must be finite and > 0 [m/s] (got 0.0)"),
+        ({"friction": True}, "friction must be a number >= 0 (got True)"),
+    ],
+)
 def test_bad_attributes_are_refused_in_python(change: dict, message: str) -> None:
     spec = mujoco.MjSpec()
     spec.worldbody.add_body(name="bearing").add_site(name="bearing")
     spec.worldbody.add_body(name="journal").add_site(name="journal")
-    kw = {"name": "joint", "journal_site": "journal", "bearing_site": "bearing", "clearance": C,
-          "journal_radius": R_J, "law": LN, "stiffness": K, "restitution": 0.9, **change}
+    kw = {
+        "name": "joint",
+        "journal_site": "journal",
+        "bearing_site": "bearing",
+        "clearance": C,
+        "journal_radius": R_J,
+        "law": LN,
+        "stiffness": K,
+        "restitution": 0.9,
+        **change,
+    }
     with pytest.raises(ValueError) as err:
         attributes.add_journal_bearing(spec, **kw)
     assert message in str(err.value)
@@ -536,13 +593,18 @@ def test_bad_attributes_are_refused_in_python(change: dict, message: str) -> Non
 def test_duplicate_name_and_sensor_lookup() -> None:
     spec = _spec(LN)
     with pytest.raises(ValueError, match="name 'joint' is already used"):
-        attributes.add_journal_bearing(spec, name="joint", journal_site="journal",
-                                       bearing_site="bearing", clearance=C, journal_radius=R_J,
-                                       law=ContactLaw.HERTZ, stiffness=K)
+        attributes.add_journal_bearing(
+            spec,
+            name="joint",
+            journal_site="journal",
+            bearing_site="bearing",
+            clearance=C,
+            journal_radius=R_J,
+            law=ContactLaw.HERTZ,
+            stiffness=K,
+        )
     model = spec.compile()
-    assert attributes.sensor_offsets(model, "joint") == dict(
-        zip(attributes.SENSOR_FIELDS, range(8))
-    )
+    assert attributes.sensor_offsets(model, "joint") == dict(zip(attributes.SENSOR_FIELDS, range(8)))
     assert attributes.state_address(model, "joint") == 0
     with pytest.raises(ValueError, match="no journal-bearing sensor named 'other'"):
         attributes.sensor_address(model, "other")
@@ -554,8 +616,7 @@ def test_add_for_clearance_uses_the_joint_parameters() -> None:
     spec.worldbody.add_body(name="bearing").add_site(name="bearing")
     spec.worldbody.add_body(name="journal").add_site(name="journal")
     cl = Clearance(radial_clearance=C, friction=0.05)
-    attributes.add_for_clearance(spec, cl, name="j", journal_site="journal",
-                                 bearing_site="bearing")
+    attributes.add_for_clearance(spec, cl, name="j", journal_site="journal", bearing_site="bearing")
     config = spec.plugins[0].config
     assert float(config["stiffness"]) == laws.bearing_stiffness(cl)  # repr round-trips exactly
     assert float(config["journal_radius"]) == cl.journal_radius
@@ -575,11 +636,22 @@ def test_without_the_library_the_compiled_mode_is_refused(monkeypatch) -> None:
     spec.worldbody.add_body(name="journal").add_site(name="journal")
     with pytest.raises(cp.PluginUnavailableError) as err:
         attributes.add_journal_bearing(
-            spec, name="joint", journal_site="journal", bearing_site="bearing", clearance=C,
-            journal_radius=R_J, law=LN, stiffness=K, restitution=0.9,
+            spec,
+            name="joint",
+            journal_site="journal",
+            bearing_site="bearing",
+            clearance=C,
+            journal_radius=R_J,
+            law=LN,
+            stiffness=K,
+            restitution=0.9,
         )
     message = str(err.value)
-    for part in ("installed without a C compiler", "install a C compiler", "reinstall",
-                 "`--contact-mode calibrated` works without the plugin"):
+    for part in (
+        "installed without a C compiler",
+        "install a C compiler",
+        "reinstall",
+        "`--contact-mode calibrated` works without the plugin",
+    ):
         assert part in message
     assert not spec.plugins
