@@ -319,8 +319,8 @@ def step_exact_ln(
         ExactLNStepError: a MuJoCo warning or a non-finite state; it names the step and
             carries the run before it.
     """
-    per_step = ctrl is not None and np.ndim(ctrl) == 2
-    if ctrl is not None and not per_step:
+    per_step = ctrl if ctrl is not None and np.ndim(ctrl) == 2 else None
+    if ctrl is not None and per_step is None:
         data.ctrl[:] = ctrl
     qpos = np.zeros((nstep, model.nq))
     qvel = np.zeros((nstep, model.nv))
@@ -329,8 +329,8 @@ def step_exact_ln(
     pen = np.zeros((nstep, len(contacts)))
     warn0 = int(data.warning.number.sum())
     for i in range(nstep):
-        if per_step:
-            data.ctrl[:] = ctrl[i]
+        if per_step is not None:
+            data.ctrl[:] = per_step[i]
         mujoco.mj_step1(model, data)
         force[i] = impose_exact_ln(model, data, contacts)
         pen[i] = [c.last_penetration for c in contacts]

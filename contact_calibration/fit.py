@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
 
 import mujoco
@@ -171,7 +172,7 @@ class CalibrationResult:
             parameters=ContactParameters(**d["parameters"]),
             initial=ContactParameters(**d["initial"]),
             mass=float(d["mass"]),
-            mass_range=tuple(float(x) for x in d["mass_range"]),
+            mass_range=valid_mass_range(float(d["mass"]), d["mass_range"]),
             timestep=float(d["timestep"]),
             speeds=tuple(float(x) for x in d["speeds"]),
             directions=tuple(float(x) for x in d["directions"]),
@@ -181,6 +182,19 @@ class CalibrationResult:
             wall_time=float(d["wall_time"]),
             meta=dict(d["meta"]),
         )
+
+
+def valid_mass_range(mass: float, mass_range: Sequence[float] | None) -> tuple[float, float]:
+    """(min, max) effective mass [kg] a calibration is valid for: ``mass_range``, else ``mass`` alone.
+
+    Raises:
+        ValueError: ``mass_range`` is not a pair.
+    """
+    if not mass_range:
+        return (float(mass), float(mass))
+    if len(mass_range) != 2:
+        raise ValueError(f"mass_range must be a pair (min, max) [kg] (got {mass_range!r})")
+    return (float(mass_range[0]), float(mass_range[1]))
 
 
 def default_speeds(impact_speed: float, n: int = 8) -> np.ndarray:
@@ -435,7 +449,7 @@ def fit_contact(
         parameters=params,
         initial=start,
         mass=float(mass),
-        mass_range=tuple(mass_range) if mass_range else (float(mass), float(mass)),
+        mass_range=valid_mass_range(mass, mass_range),
         timestep=options.timestep,
         speeds=tuple(float(v) for v in speeds),
         directions=tuple(float(d) for d in directions),

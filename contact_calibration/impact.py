@@ -44,7 +44,7 @@ from __future__ import annotations
 import math
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, TypedDict, Unpack
 
 import numpy as np
 from scipy.integrate import DenseOutput, OdeSolution, solve_ivp
@@ -63,10 +63,30 @@ __all__ = [
     "simulate_oblique_impact",
     "law_impact",
     "clearance_impact",
+    "SolverOptions",
+    "LawOptions",
 ]
 
 ForceLaw = Callable[[Any, Any, float], Any]
 """force(δ [m], δ̇ [m/s], approach speed [m/s]) -> normal force [N] >= 0."""
+
+
+class SolverOptions(TypedDict, total=False):
+    """The solver keywords of `simulate_impact` (see there) that `law_impact` passes on."""
+
+    rtol: float
+    atol: float | None
+    max_duration: float | None
+    n_samples: int
+
+
+class LawOptions(SolverOptions, total=False):
+    """The keywords `clearance_impact` passes on to `law_impact` (see there)."""
+
+    exponent: float
+    c_max: float | None
+    d_max: float | None
+
 
 _MAX_STEP = 0.5  # in units of t_s; the Hertz contact lasts about 3 t_s
 _FIRST_STEP = 1e-4  # in units of t_s
@@ -199,6 +219,18 @@ class _Coast(DenseOutput):
         return self.y0[:, None] + self.rate[:, None] * dt
 
 
+@dataclass(frozen=True)
+class _Event:
+    """A `solve_ivp` event function with the ``terminal`` and ``direction`` scipy reads from it."""
+
+    fn: Callable[[float, np.ndarray], float]
+    terminal: bool
+    direction: float
+
+    def __call__(self, t: float, y: np.ndarray) -> float:
+        return self.fn(t, y)
+
+
 def _reengagement(force: ForceLaw, delta: float, rate: float, v: float) -> float:
     """Fraction u in [0, 1) of ``delta`` at which a mass coasting at ``rate`` < 0 is pushed.
 
@@ -223,8 +255,8 @@ def _reengagement(force: ForceLaw, delta: float, rate: float, v: float) -> float
 
 def _simulate(
     force: ForceLaw,
-    mass: Any,
-    speed: Any,
+    mass: float,
+    speed: float,
     tangential_speed: float | None,
     friction: float,
     v0: float,
@@ -243,7 +275,7 @@ def _simulate(
     if not isinstance(n_samples, (int, np.integer)) or isinstance(n_samples, bool) or n_samples < 2:
         raise ValueError(f"n_samples must be an integer >= 2 (got {n_samples!r})")
     oblique = tangential_speed is not None
-    if oblique:
+    if tangential_speed is not None:
         w0 = float(tangential_speed)
         if not math.isfinite(w0):
             raise ValueError(f"tangential_speed must be finite (got {tangential_speed!r} m/s)")
@@ -262,10 +294,10 @@ def _simulate(
         return [y[1], -gain * f, gain * ft]
 
     def separation(_: float, y: np.ndarray) -> float:
-        return y[0]
+        return float(y[0])
 
     def turning(_: float, y: np.ndarray) -> float:
-        return y[1]
+        return float(y[1])
 
     def released(_: float, y: np.ndarray) -> float:
         # > 0 while the law pushes; -1 once it has let go of a receding mass inside the
@@ -275,9 +307,7 @@ def _simulate(
             return gain * f
         return -1.0 if y[0] > 0 and y[1] < 0 else 1.0
 
-    separation.terminal, separation.direction = True, -1  # type: ignore[attr-defined]
-    turning.direction = -1  # type: ignore[attr-defined]
-    released.terminal, released.direction = True, -1  # type: ignore[attr-defined]
+    events = (_Event(separation, True, -1), _Event(turning, False, -1), _Event(released, True, -1))
 
     def no_separation(message: str) -> RuntimeError:
         return RuntimeError(
@@ -293,7 +323,7 @@ def _simulate(
             rtol=rtol,
             atol=atol,
             dense_output=True,
-            events=(separation, turning, released),
+            events=events,
             max_step=_MAX_STEP,
             first_step=first_step,
         )
@@ -311,7 +341,8 @@ def _simulate(
         turns.extend((te, ye[0]) for te, ye in zip(sol.t_events[1], sol.y_events[1]) if te <= sol.t[n])
 
     t, y = 0.0, np.array([0.0, 1.0] + ([w0 / v] if oblique else []))
-    first, redone = _FIRST_STEP, math.nan
+    first: float | None = _FIRST_STEP
+    redone = math.nan
     for _ in range(_MAX_PHASES):
         sol = integrate(t, t_end, y, first)
         if sol.status == 1 and sol.t[-2] != redone and sol.t[-1] > sol.t[-2]:
@@ -474,7 +505,7 @@ def law_impact(
     exponent: float = 1.5,
     c_max: float | None = None,
     d_max: float | None = None,
-    **kw: Any,
+    **kw: Unpack[SolverOptions],
 ) -> ImpactResult:
     """`simulate_impact` under one of the laws of `clearance.contact_calibration.laws`.
 
@@ -502,14 +533,14 @@ def law_impact(
     )
     k, n = float(stiffness), float(exponent)
     if law is ContactLaw.IMPACT:
-        c, dm = float(c_max), float(d_max)  # type: ignore[arg-type]
+        c, dm = laws._impact_params(c_max, d_max)
 
-        def force(d: Any, dd: Any, _: Any) -> Any:
+        def force(d: Any, dd: Any, vin: float) -> Any:
             return laws._impact(d, dd, k, n, c, dm)
     else:
         chi = laws.hysteresis_factor(law, restitution)
 
-        def force(d: Any, dd: Any, vin: Any) -> Any:
+        def force(d: Any, dd: Any, vin: float) -> Any:
             if isinstance(d, float):
                 return 0.0 if d <= 0 else max(k * d**n * (1.0 + chi * dd / vin), 0.0)
             return laws._dissipative(d, dd, vin, k, chi, n)
@@ -517,7 +548,7 @@ def law_impact(
     return simulate_impact(force, mass=mass, speed=speed, **kw)
 
 
-def clearance_impact(clearance: Clearance, *, mass: float, speed: float, **kw: Any) -> ImpactResult:
+def clearance_impact(clearance: Clearance, *, mass: float, speed: float, **kw: Unpack[LawOptions]) -> ImpactResult:
     """`law_impact` with K = `laws.bearing_stiffness` and the clearance's law and cₑ.
 
     Args:

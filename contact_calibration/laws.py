@@ -524,7 +524,13 @@ def normal_force(
     if law is ContactLaw.HERTZ:
         return hertz(delta, stiffness=stiffness, exponent=exponent)
     if law is ContactLaw.IMPACT:
-        return impact_law(delta, delta_dot, stiffness=stiffness, exponent=exponent, c_max=c_max, d_max=d_max)  # type: ignore[arg-type]
+        c, d = _impact_params(c_max, d_max)
+        return impact_law(delta, delta_dot, stiffness=stiffness, exponent=exponent, c_max=c, d_max=d)
+    if approach_speed is None:
+        raise ValueError(
+            f"the {law.value} law needs approach_speed > 0 [m/s] (got None): the dissipative laws "
+            "divide by the approach speed recorded at contact onset"
+        )
     return _law(law, delta, delta_dot, approach_speed, stiffness, restitution, exponent)
 
 

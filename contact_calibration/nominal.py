@@ -17,9 +17,10 @@ from __future__ import annotations
 import math
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.optimize import brentq
 
-from clearance.contact_calibration.impact import law_impact, simulate_impact
+from clearance.contact_calibration.impact import ForceLaw, ImpactResult, law_impact, simulate_impact
 from clearance.contact_calibration.laws import bearing_stiffness
 from clearance.mjcf.bearing import (
     RingGeometry,
@@ -35,19 +36,22 @@ NOMINAL_IMPACT_SPEED = 4.0
 """Impact speed [m/s] at which nominal damping matches LN restitution."""
 
 
-def _ring_law(geom: RingGeometry, k: float, b: float, delta_ref: float):
+def _ring_law(geom: RingGeometry, k: float, b: float, delta_ref: float) -> ForceLaw:
+    """The ring's normal force law: stiffness fitted over 1/20-2 ``delta_ref``, damping at it."""
     c_k = ring_stiffness_coefficient(geom, (delta_ref / 20, delta_ref * 2))
     # ring damping ~ a sqrt(delta): fit a at the reference depth
     a = ring_damping_coefficient(geom, delta_ref) / math.sqrt(delta_ref)
 
-    def force(delta, delta_dot, _v):
+    def force(delta: ArrayLike, delta_dot: ArrayLike, _v: float) -> float | np.ndarray:
         d = np.maximum(delta, 0.0)
-        return np.maximum(c_k * k * d**1.5 + b * a * np.sqrt(d) * delta_dot, 0.0)
+        return np.maximum(c_k * k * d**1.5 + b * a * np.sqrt(d) * np.asarray(delta_dot, dtype=float), 0.0)
 
     return force
 
 
-def ring_impact(geom: RingGeometry, params: ContactParameters, *, mass: float, speed: float, delta_ref: float):
+def ring_impact(
+    geom: RingGeometry, params: ContactParameters, *, mass: float, speed: float, delta_ref: float
+) -> ImpactResult:
     """Radial impact of a journal of ``mass`` [kg] at ``speed`` [m/s] on the ring model.
 
     Returns the `ImpactResult` of the closed-form ring law (no MuJoCo).

@@ -24,7 +24,7 @@ import math
 import os
 import warnings
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import mujoco
 import numpy as np
@@ -35,6 +35,7 @@ from clearance.contact_calibration.fit import (
     check_stability,
     default_speeds,
     fit_contact,
+    valid_mass_range,
 )
 from clearance.mjcf.bearing import RingGeometry
 from clearance.model import Clearance, Joint
@@ -54,6 +55,31 @@ __all__ = [
     "calibrate_joint",
     "calibrated_parameters",
 ]
+
+
+class Sizing(Protocol):
+    """What a calibration reads of a clearance joint's sizing (`clearance.run.JointSizing` has it)."""
+
+    @property
+    def effective_mass(self) -> float:
+        """Median effective mass over the cycle [kg]."""
+        ...
+
+    @property
+    def effective_mass_range(self) -> tuple[float, float]:
+        """(min, max) effective mass over the cycle [kg]."""
+        ...
+
+    @property
+    def impact_speed(self) -> float:
+        """Estimated impact speed [m/s]."""
+        ...
+
+    @property
+    def penetration_limit(self) -> float:
+        """Divergence bound on the penetration [m]."""
+        ...
+
 
 CACHE_ENV = "CLEARANCE_CACHE_DIR"
 """Environment variable naming the cache directory."""
@@ -234,7 +260,7 @@ def calibrate(
             raise ValueError("give impact_speed [m/s] or speeds [m/s]")
         speeds = default_speeds(impact_speed)
     speeds = np.sort(np.asarray(speeds, dtype=float))
-    mrange = tuple(mass_range) if mass_range else (float(mass), float(mass))
+    mrange = valid_mass_range(mass, mass_range)
     key = calibration_key(clearance, ring, options, mass=mass, mass_range=mrange, speeds=speeds)
     if use_cache:
         hit = load_calibration(key)
@@ -266,7 +292,7 @@ def calibrate(
 def calibrate_joint(
     joint: Joint,
     ring: RingGeometry,
-    sizing: Any,
+    sizing: Sizing,
     options: ModelOptions,
     *,
     speeds: np.ndarray | None = None,
@@ -299,7 +325,6 @@ def calibrate_joint(
     """
     if joint.clearance is None:
         raise ValueError(f"joint '{joint.name}' has no clearance to calibrate")
-    mrange = getattr(sizing, "effective_mass_range", None)
     return calibrate(
         joint.clearance,
         ring,
@@ -307,13 +332,13 @@ def calibrate_joint(
         mass=float(sizing.effective_mass),
         impact_speed=float(sizing.impact_speed),
         speeds=speeds,
-        mass_range=tuple(mrange) if mrange else None,
+        mass_range=sizing.effective_mass_range,
         max_penetration=float(sizing.penetration_limit),
         use_cache=use_cache,
     )
 
 
-def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Any, options: ModelOptions) -> ContactParameters:
+def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Sizing, options: ModelOptions) -> ContactParameters:
     """Calibrated per-row contact parameters of a clearance joint (cached).
 
     The entry point of `ContactMode.CALIBRATED` in `clearance.run.preparation`; it reuses the

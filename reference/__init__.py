@@ -34,6 +34,7 @@ from clearance.reference.run import (
 )
 from clearance.reference.system import (
     Evaluation,
+    ReferenceOptions,
     ReferenceSystem,
     SingularConstraintsError,
 )
@@ -42,6 +43,7 @@ __all__ = [
     "METHODS",
     "Evaluation",
     "IntegrationFailure",
+    "ReferenceOptions",
     "ReferenceSolverError",
     "ReferenceSystem",
     "SingularConstraintsError",

@@ -21,6 +21,9 @@ from clearance.model import Drive, DriveKind, Joint, JointType
 
 __all__ = ["DriveRow", "ConstraintRows"]
 
+_Pair = tuple[bool, int, int, float, float, float, float, float, float, float]
+"""One ideal joint: (revolute?, ia, ib, sax, say, sbx, sby, ux, uy, offset)."""
+
 
 class DriveRow:
     """Scalar evaluation of one drive (prescribed angle, rate, acceleration; or torque).
@@ -37,9 +40,10 @@ class DriveRow:
     def __init__(self, drive: Drive, ia: int, ib: int) -> None:
         self.name, self.kind, self.ia, self.ib = drive.name, drive.kind, ia, ib
         self.theta0, self.torque = drive.start_angle, drive.torque
-        self.speed, self.harmonics, self.w = drive.speed, (), 0.0
+        self.speed, self.w = drive.speed, 0.0
+        self.harmonics: tuple[tuple[float, float], ...] = ()
         if drive.kind is DriveKind.MOTION_LAW:
-            law = drive.motion
+            law = drive.require_motion()
             self.speed, self.harmonics, self.w = law.speed, tuple(law.harmonics), law.fundamental
 
     def evaluate(self, t: float) -> tuple[float, float, float]:
@@ -76,7 +80,7 @@ class ConstraintRows:
         offsets: Mapping[str, float],
         nq: int,
     ) -> None:
-        self.pairs: list[tuple] = []  # (revolute?, ia, ib, sax, say, sbx, sby, ux, uy, offset)
+        self.pairs: list[_Pair] = []
         self.pair_names: list[str] = []
         for j in joints:
             if j.clearance is not None:
@@ -155,7 +159,7 @@ class ConstraintRows:
             else:
                 xb = yb = thb = 0.0
                 bx, by = sbx, sby
-            if vel:
+            if zdl is not None:
                 va = zdl[3 * ia : 3 * ia + 3] if ia >= 0 else zero3
                 vb = zdl[3 * ib : 3 * ib + 3] if ib >= 0 else zero3
                 wa, wb = va[2], vb[2]

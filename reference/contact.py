@@ -90,7 +90,8 @@ def contact_joints(
         c_max, d_max: IMPACT parameters, required if a joint uses the IMPACT law.
 
     Raises:
-        ValueError: bad thresholds, or an IMPACT joint without c_max and d_max.
+        ValueError: bad thresholds, an IMPACT joint without c_max and d_max, or a
+            clearance that names no journal link.
     """
     if not (math.isfinite(v0) and math.isfinite(v1) and 0 <= v0 < v1):
         raise ValueError(f"friction thresholds must satisfy 0 <= v0 < v1 [m/s] (got {v0!r}, {v1!r})")
@@ -100,6 +101,8 @@ def contact_joints(
         if cl is None:
             continue
         jl = cl.journal_link
+        if jl is None:
+            raise ValueError(f"joint '{j.name}': its clearance names no journal link (a Mechanism resolves it)")
         if jl == j.link_a:
             bl, sj, sb = j.link_b, rel(j.link_a, j.point_a), rel(j.link_b, j.point_b)
         else:

@@ -24,6 +24,7 @@ import math
 from collections.abc import Callable
 
 import numpy as np
+from numpy.typing import ArrayLike
 from scipy.optimize import brentq, minimize_scalar
 
 from clearance.reference.contact import evaluate_contact
@@ -32,6 +33,9 @@ from clearance.reference.system import ReferenceSystem
 __all__ = ["gap", "gap_many", "hermite_extreme", "find_mode_change"]
 
 _MAX_SUB = 512  # sub-intervals per step at most
+
+_Column = np.ndarray | float
+"""A quantity over many states (ndarray) or, for the ground, one constant."""
 
 
 def gap(system: ReferenceSystem, k: int, y: np.ndarray) -> tuple[float, float, float]:
@@ -45,7 +49,7 @@ def gap_many(system: ReferenceSystem, k: int, ys: np.ndarray) -> tuple[np.ndarra
     """(delta, delta_dot) of joint k for states ys of shape (ny, n), vectorised."""
     cj, nq = system.contacts[k], system.nq
 
-    def centre(i: int, s: tuple[float, float]):
+    def centre(i: int, s: tuple[float, float]) -> tuple[_Column, _Column, _Column, _Column]:
         if i < 0:
             return s[0], s[1], 0.0, 0.0
         th, w = ys[3 * i + 2], ys[nq + 3 * i + 2]
@@ -86,7 +90,7 @@ def hermite_extreme(p0: float, p1: float, m0: float, m1: float, want_max: bool) 
 def find_mode_change(
     system: ReferenceSystem,
     k: int,
-    dense: Callable[[], Callable],
+    dense: Callable[[], Callable[[ArrayLike], np.ndarray]],
     t0: float,
     t1: float,
     g0: tuple[float, float, float],

@@ -11,11 +11,12 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from typing import Unpack
 
 import numpy as np
 
 from clearance.model import Clearance, Joint, JointType, Link
-from clearance.reference.system import ReferenceSystem
+from clearance.reference.system import ReferenceOptions, ReferenceSystem
 
 __all__ = ["journal_in_bearing"]
 
@@ -28,7 +29,7 @@ def journal_in_bearing(
     speed: float,
     direction: float = 0.0,
     tangential_speed: float = 0.0,
-    **options,
+    **options: Unpack[ReferenceOptions],
 ) -> tuple[ReferenceSystem, np.ndarray, np.ndarray]:
     """A free body (journal at its centre of mass) inside a ground-fixed bearing.
 

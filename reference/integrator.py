@@ -71,8 +71,8 @@ class Trajectory:
     zd: np.ndarray
     vin: np.ndarray
     work: np.ndarray | None
-    onsets: list = field(default_factory=list)
-    ends: list = field(default_factory=list)
+    onsets: list[tuple[float, int, float]] = field(default_factory=list)
+    ends: list[tuple[float, int]] = field(default_factory=list)
     n_rhs: int = 0
     n_steps: int = 0
     n_restarts: int = 0
@@ -127,7 +127,7 @@ def integrate_system(
     tol = np.concatenate([atol, np.full(ny - 2 * nq, 1e100)])
     out_y = np.empty((n_out, ny))
     out_vin = np.zeros((n_out, nc))
-    traj = Trajectory(grid, None, None, None, None)  # arrays set in _finish
+    traj = Trajectory(grid, np.empty((0, nq)), np.empty((0, nq)), np.empty((0, nc)), None)  # set in finish
     count = [0]
     limits = list(max_penetration) if max_penetration is not None else [math.inf] * nc
     solver_cls = getattr(integrate, method)
@@ -158,7 +158,7 @@ def integrate_system(
     while t < t_end:
         seg_vin = tuple(vin)
 
-        def fun(tt: float, yy: np.ndarray, _v=seg_vin) -> np.ndarray:
+        def fun(tt: float, yy: np.ndarray, _v: tuple[float, ...] = seg_vin) -> np.ndarray:
             count[0] += 1
             return system.rhs(tt, yy, _v)
 
@@ -241,16 +241,18 @@ def integrate_system(
 class _Dense:
     """The current step's dense output, built on first use (DOP853 spends 3 calls on it, LSODA none)."""
 
-    def __init__(self, solver) -> None:
-        self.solver, self.sol = solver, None
+    def __init__(self, solver: integrate.OdeSolver) -> None:
+        self.solver = solver
+        self.sol: integrate.DenseOutput | None = None
 
-    def __call__(self):
+    def __call__(self) -> integrate.DenseOutput:
         if self.sol is None:
             self.sol = self.solver.dense_output()
         return self.sol
 
 
-def _deepest(system: ReferenceSystem, geo: list) -> str | None:
+def _deepest(system: ReferenceSystem, geo: Sequence[tuple[float, float, float]]) -> str | None:
+    """The clearance joint of deepest penetration, or None without clearance joints."""
     if not geo:
         return None
     k = int(np.argmax([g[0] for g in geo]))

@@ -30,7 +30,8 @@ from clearance.version import __version__
 
 __all__ = ["Stabilisation", "ReferenceSolverError", "run_reference", "simulate_system"]
 
-Progress = bool | Callable[[float, float], Any]
+Progress = bool | Callable[[float, float], object]
+"""False, True for a tqdm bar, or a callable progress(t [s], duration [s])."""
 
 
 class Stabilisation(enum.Enum):
@@ -177,7 +178,7 @@ def simulate_system(
         pos = np.abs(np.concatenate([z0, zd0]))
         weight = atol_v + rtol * pos
         proj = (10.0 * float(weight[:nq].max()), 10.0 * float(weight[nq:].max()))
-    bar, cb = _progress(progress, duration, system.name)
+    close, cb = _progress(progress, duration, system.name)
     try:
         traj = integrate_system(
             system,
@@ -197,8 +198,7 @@ def simulate_system(
     except IntegrationFailure as exc:
         traj, failure = exc.trajectory, exc
     finally:
-        if bar is not None:
-            bar.close()
+        close()
     settings = dict(
         method=method,
         rtol=rtol,
@@ -208,24 +208,24 @@ def simulate_system(
         duration=duration,
         max_penetration=limits,
     )
-    result = to_result(system, traj, settings) if len(traj.times) else None
-    if failure is not None:
-        remedy = (
-            "check the contact parameters and the drive speed, or raise max_penetration"
-            if "penetration" in str(failure)
-            else "check the mechanism for a singular (dead-centre) position"
-            if "singular" in str(failure)
-            else "try rtol=1e-8 or method='Radau'"
-        )
-        raise ReferenceSolverError(
-            f"reference run of '{system.name}' failed at t = {failure.time:.9g} s"
-            f"{f' (joint {failure.joint!r})' if failure.joint else ''}: {failure}. Remedy: {remedy}. "
-            "The result computed so far is attached as .partial.",
-            result,
-            time=failure.time,
-            joint=failure.joint,
-        )
-    return result
+    if failure is None:
+        return to_result(system, traj, settings)
+    partial = to_result(system, traj, settings) if len(traj.times) else None
+    remedy = (
+        "check the contact parameters and the drive speed, or raise max_penetration"
+        if "penetration" in str(failure)
+        else "check the mechanism for a singular (dead-centre) position"
+        if "singular" in str(failure)
+        else "try rtol=1e-8 or method='Radau'"
+    )
+    raise ReferenceSolverError(
+        f"reference run of '{system.name}' failed at t = {failure.time:.9g} s"
+        f"{f' (joint {failure.joint!r})' if failure.joint else ''}: {failure}. Remedy: {remedy}. "
+        "The result computed so far is attached as .partial.",
+        partial,
+        time=failure.time,
+        joint=failure.joint,
+    )
 
 
 def run_reference(
@@ -301,9 +301,12 @@ def run_reference(
     )
 
 
-def _progress(progress: Progress, duration: float, name: str):
+def _progress(
+    progress: Progress, duration: float, name: str
+) -> tuple[Callable[[], None], Callable[[float], None] | None]:
+    """(close, callback): what ends the progress display, and the integrator's callback (t [s])."""
     if progress is False:
-        return None, None
+        return _nothing, None
     if progress is True:
         from tqdm.auto import tqdm
 
@@ -314,8 +317,17 @@ def _progress(progress: Progress, duration: float, name: str):
             bar.update(t * 1e3 - done[0])
             done[0] = t * 1e3
 
-        return bar, cb
-    return None, lambda t: progress(t, duration)
+        return bar.close, cb
+    report = progress
+
+    def call(t: float) -> None:
+        report(t, duration)
+
+    return _nothing, call
+
+
+def _nothing() -> None:
+    """No progress display to close."""
 
 
 def to_result(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any]) -> SimulationResult:
@@ -332,8 +344,8 @@ def to_result(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any
 
 def _metadata(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any]) -> dict[str, Any]:
     mech = system.mechanism
-    onsets: dict[str, list] = {n: [] for n in system.contact_names}
-    ends: dict[str, list] = {n: [] for n in system.contact_names}
+    onsets: dict[str, list[list[float]]] = {n: [] for n in system.contact_names}
+    ends: dict[str, list[float]] = {n: [] for n in system.contact_names}
     for t, k, v in traj.onsets:
         onsets[system.contact_names[k]].append([t, v])
     for t, k in traj.ends:

@@ -21,27 +21,39 @@ from __future__ import annotations
 import dataclasses
 import math
 from collections.abc import Sequence
-from typing import Any, NamedTuple
+from typing import NamedTuple, TypedDict, Unpack
 
 import numpy as np
 from scipy.linalg.lapack import dposv
 
 from clearance.contact_calibration.laws import MIN_APPROACH_SPEED
 from clearance.kinematics import assemble, velocities
-from clearance.model import DriveKind, Joint, Link, Mechanism, MotionLaw
+from clearance.model import Drive, DriveKind, Joint, Link, Mechanism, MotionLaw
 from clearance.reference.constraints import ConstraintRows
 from clearance.reference.contact import ContactJoint, contact_joints, evaluate_contact
 
-__all__ = ["ReferenceSystem", "SingularConstraintsError", "Evaluation"]
+__all__ = ["ReferenceSystem", "ReferenceOptions", "SingularConstraintsError", "Evaluation"]
 
-_DEFAULTS: dict[str, Any] = dict(
-    baumgarte=(5.0, 5.0),
-    min_approach_speed=MIN_APPROACH_SPEED,
-    friction_v0=1e-4,
-    friction_v1=1e-3,
-    impact_c_max=None,
-    impact_d_max=None,
-)
+
+class ReferenceOptions(TypedDict, total=False):
+    """The keyword options of `ReferenceSystem` (see there)."""
+
+    baumgarte: tuple[float, float]
+    min_approach_speed: float
+    friction_v0: float
+    friction_v1: float
+    impact_c_max: float | None
+    impact_d_max: float | None
+
+
+_DEFAULTS: ReferenceOptions = {
+    "baumgarte": (5.0, 5.0),
+    "min_approach_speed": MIN_APPROACH_SPEED,
+    "friction_v0": 1e-4,
+    "friction_v1": 1e-3,
+    "impact_c_max": None,
+    "impact_d_max": None,
+}
 
 
 class SingularConstraintsError(ArithmeticError):
@@ -72,9 +84,9 @@ class Evaluation(NamedTuple):
 
     zdd: np.ndarray
     lam: np.ndarray
-    phi: list
-    contacts: list
-    drive_torque: list
+    phi: list[float]
+    contacts: list[tuple[float, ...]]
+    drive_torque: list[float]
 
 
 class ReferenceSystem:
@@ -99,7 +111,7 @@ class ReferenceSystem:
         ValueError: an argument out of range, or an IMPACT joint without its parameters.
     """
 
-    def __init__(self, mechanism: Mechanism, **options: Any) -> None:
+    def __init__(self, mechanism: Mechanism, **options: Unpack[ReferenceOptions]) -> None:
         if not isinstance(mechanism, Mechanism):
             raise TypeError(f"mechanism must be a Mechanism (got {type(mechanism).__name__})")
         self._build(mechanism.links, mechanism.joints, mechanism.drives, mechanism.ground, mechanism.gravity, options)
@@ -113,10 +125,10 @@ class ReferenceSystem:
         joints: Sequence[Joint],
         *,
         ground: str = "ground",
-        drives: Sequence = (),
+        drives: Sequence[Drive] = (),
         gravity: tuple[float, float] = (0.0, 0.0),
         name: str = "system",
-        **options: Any,
+        **options: Unpack[ReferenceOptions],
     ) -> ReferenceSystem:
         """A system from links and joints, without the mechanism's one-drive-per-DOF rule.
 
@@ -148,11 +160,19 @@ class ReferenceSystem:
         self.name = name
         return self
 
-    def _build(self, links, joints, drives, ground, gravity, options) -> None:
+    def _build(
+        self,
+        links: Sequence[Link],
+        joints: Sequence[Joint],
+        drives: Sequence[Drive],
+        ground: str,
+        gravity: Sequence[float],
+        options: ReferenceOptions,
+    ) -> None:
         unknown = set(options) - set(_DEFAULTS)
         if unknown:
             raise TypeError(f"unexpected keyword argument(s) {sorted(unknown)}")
-        o = {**_DEFAULTS, **options}
+        o: ReferenceOptions = {**_DEFAULTS, **options}
         try:
             alpha, beta = (float(v) for v in o["baumgarte"])
         except (TypeError, ValueError):
@@ -313,7 +333,7 @@ class ReferenceSystem:
                     q[3 * k + 2] += r[10]
         qa = np.array(q)
         if self.n_constraints == 0:
-            return Evaluation(self.minv * qa, np.zeros(0), [], cres, self._torques(None))
+            return Evaluation(self.minv * qa, np.zeros(0), [], cres, self._torques(np.zeros(0)))
         phi, gam, phit = self.rows.evaluate(t, zl, zdl)
         g = self.rows.G
         gs = np.array(gam)
@@ -325,7 +345,7 @@ class ReferenceSystem:
         zdd = self.minv * (qa - g.T @ lam)
         return Evaluation(zdd, lam, phi, cres, self._torques(lam))
 
-    def _torques(self, lam: np.ndarray | None) -> list[float]:
+    def _torques(self, lam: np.ndarray) -> list[float]:
         out = []
         for d, row in zip(self.drives, self._drive_row):
             out.append(d.torque if row < 0 else -float(lam[row]))
@@ -379,8 +399,7 @@ class ReferenceSystem:
             return z, zd
         z = np.array(z, dtype=float)
         for _ in range(max_iter):
-            phi, _, _ = self.rows.evaluate(t, z.tolist())
-            phi = np.array(phi)
+            phi = np.array(self.rows.evaluate(t, z.tolist())[0])
             g = self.rows.G
             gm = g * self.minv
             if np.max(np.abs(phi)) <= tol:
