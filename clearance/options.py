@@ -30,12 +30,20 @@ class ContactMode(enum.Enum):
         section 1) spread over the ring, damping giving LN's restitution at a nominal
         impact speed; no fitting.
     CALIBRATED: parameters fitted to LN impacts (`clearance.contact_calibration`), cached.
-    EXACT_LN: the LN law applied inside MuJoCo's solver each step (Python step loop).
+    EXACT: every clearance joint's own contact law (any `ContactLaw`, with Ambrósio
+        friction) computed on exact circle geometry by the compiled engine plugin
+        `clearance.journal_bearing` (`clearance.contact_plugin`); no ring, no contact rows.
+        ``"exact_ln"`` is accepted for it (the name it had when it imposed LN alone).
     """
 
     NOMINAL = "nominal"
     CALIBRATED = "calibrated"
-    EXACT_LN = "exact_ln"
+    EXACT = "exact"
+    EXACT_LN = "exact"  # the same member: the mode's name when it imposed LN alone
+
+    @classmethod
+    def _missing_(cls, value: object) -> ContactMode | None:
+        return cls.EXACT if value == "exact_ln" else None
 
 
 @dataclass(frozen=True)

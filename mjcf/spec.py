@@ -28,7 +28,7 @@ from clearance.kinematics import assemble, velocities
 from clearance.mjcf.bearing import RingGeometry, segment_centres
 from clearance.mjcf.tree import BodyTree, body_tree
 from clearance.model import DriveKind, Joint, JointType, Link, Mechanism, OutputKind
-from clearance.options import GeomType, ModelOptions
+from clearance.options import ContactMode, GeomType, ModelOptions
 
 __all__ = ["BuiltModel", "build_spec", "drive_armature", "drive_gear", "ring_geometry"]
 
@@ -48,6 +48,10 @@ class BuiltModel:
         journal_body, bearing_body: clearance joint name -> body name.
         drive_gear: drive name -> +1 or -1 (sign between hinge qpos and drive angle).
         q0, qd0: assembled Cartesian coordinates and ideal velocities at t = 0.
+        link_order: moving links in the order of the Cartesian coordinates.
+        exact_contact: the compiled-contact family: clearance joints have sites and visual
+            geoms only (no ring, no pairs, no contact sensor); their contact is added by the
+            run as engine-plugin instances (`clearance.contact_plugin`).
     """
 
     spec: mujoco.MjSpec
@@ -59,6 +63,7 @@ class BuiltModel:
     q0: np.ndarray
     qd0: np.ndarray
     link_order: tuple[str, ...] = ()
+    exact_contact: bool = False
 
 
 def ring_geometry(joint: Joint, segments: int, options: ModelOptions) -> RingGeometry:
@@ -219,6 +224,7 @@ def build_spec(
             f"{j.name}__a",
         )
 
+    exact = options.contact_mode is ContactMode.EXACT
     rings, jbody, bbody = {}, {}, {}
     for j in mechanism.clearance_joints:
         cl = j.require_clearance()
@@ -229,7 +235,10 @@ def build_spec(
         bp = links[bl].point(j.point_a if bl == j.link_a else j.point_b)
         ring = ring_geometry(j, segments[j.name], options)
         rings[j.name], jbody[j.name], bbody[j.name] = ring, jl, bl
-        _journal_and_bearing(spec, bodies[jl], bodies[bl], j.name, jp, bp, ring, options, cl.friction)
+        if exact:
+            _journal_and_bearing_visual(bodies[jl], bodies[bl], j.name, jp, bp, ring)
+        else:
+            _journal_and_bearing(spec, bodies[jl], bodies[bl], j.name, jp, bp, ring, options, cl.friction)
         _site(bodies[jl], f"{j.name}__journal", jp)
         _site(bodies[bl], f"{j.name}__bearing", bp)
         _sensor(
@@ -245,6 +254,8 @@ def build_spec(
         _sensor(spec, f"{j.name}__bvel", _SENS.mjSENS_FRAMELINVEL, _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
         _sensor(spec, f"{j.name}__bangvel", _SENS.mjSENS_FRAMEANGVEL, _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
         _sensor(spec, f"{j.name}__bxaxis", _SENS.mjSENS_FRAMEXAXIS, _OBJ.mjOBJ_SITE, f"{j.name}__bearing")
+        if exact:
+            continue  # the contact's force is the plugin's sensor
         s = _sensor(
             spec,
             f"{j.name}__force",
@@ -287,7 +298,7 @@ def build_spec(
         _sensor(spec, f"{d.name}__speed", _SENS.mjSENS_JOINTVEL, _OBJ.mjOBJ_JOINT, d.joint)
         _sensor(spec, f"{d.name}__torque", _SENS.mjSENS_ACTUATORFRC, _OBJ.mjOBJ_ACTUATOR, d.name)
 
-    return BuiltModel(spec, tree, rings, jbody, bbody, gears, q0, qd0, tuple(names))
+    return BuiltModel(spec, tree, rings, jbody, bbody, gears, q0, qd0, tuple(names), exact)
 
 
 def _drive_gain(mechanism: Mechanism, options: ModelOptions) -> float:
@@ -346,6 +357,38 @@ def _geom_type(g: GeomType) -> int:
         GeomType.BOX: mujoco.mjtGeom.mjGEOM_BOX,
         GeomType.CYLINDER: mujoco.mjtGeom.mjGEOM_CYLINDER,
     }[g]
+
+
+def _journal_and_bearing_visual(
+    jbody: mujoco.MjsBody,
+    bbody: mujoco.MjsBody,
+    name: str,
+    jp: tuple[float, float],
+    bp: tuple[float, float],
+    ring: RingGeometry,
+) -> None:
+    """Journal and bearing drawn for the viewer only (the compiled contact needs no geometry)."""
+    jbody.add_geom(
+        name=f"{name}__journal",
+        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+        size=[ring.journal_radius, _THICK, 0],
+        pos=[jp[0], jp[1], 0],
+        rgba=[0.85, 0.35, 0.2, 1.0],
+        contype=0,
+        conaffinity=0,
+        mass=0,
+    )
+    bbody.add_geom(
+        name=f"{name}__bearing",
+        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+        size=[ring.bearing_radius, 0.5 * _THICK, 0],
+        pos=[bp[0], bp[1], 0],
+        rgba=[0.3, 0.45, 0.75, 0.35],
+        group=2,
+        contype=0,
+        conaffinity=0,
+        mass=0,
+    )
 
 
 def _journal_and_bearing(

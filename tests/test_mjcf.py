@@ -28,7 +28,9 @@ def _check_golden(xml: str, path: Path) -> None:
     if os.environ.get("CLEARANCE_UPDATE_GOLDEN"):
         path.write_text(xml)
     assert path.exists(), f"no golden file {path.name}: generate it with CLEARANCE_UPDATE_GOLDEN=1"
-    assert xml == path.read_text(), f"{path.name} differs: regenerate with CLEARANCE_UPDATE_GOLDEN=1 after a deliberate change"
+    assert xml == path.read_text(), (
+        f"{path.name} differs: regenerate with CLEARANCE_UPDATE_GOLDEN=1 after a deliberate change"
+    )
 
 
 def test_golden_mjcf_for_default_slider_crank(default_mechanism):

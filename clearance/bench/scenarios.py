@@ -2,7 +2,8 @@
 
 The scenarios of the benchmark (the default slider-crank, the same at c = 0.1 mm, the same
 at 200 rpm with gravity, and the seven-bar press with clearances A and C) and the grid of
-settings (time step x segment count x contact mode, two more geom pairs, exact-LN mode) are
+settings (time step x segment count x ring contact mode, two more geom pairs, the compiled exact
+contact at several steps) are
 defined here; the machinery is in `clearance.bench.speed_error` and
 `clearance.bench.speed_error_report`. Like the CLI, this module is the top of the
 pipeline: it names builders and hands them to the analysis as picklable factories.
@@ -35,7 +36,7 @@ def settings_grid(
     pair_timestep: float | None = None,
     exact_timesteps: Sequence[float] = (),
 ) -> tuple[Setting, ...]:
-    """Time step x segment count x contact mode (sphere/sphere), plus other pairs and exact LN.
+    """Time step x segment count x ring contact mode (sphere/sphere), plus other pairs and exact contact.
 
     Args:
         timesteps: time steps [s].
@@ -43,14 +44,14 @@ def settings_grid(
         modes: contact modes of the grid.
         pair_timestep: time step of the capsule/capsule and sphere/box settings (calibrated,
             ripple-rule N); None leaves them out.
-        exact_timesteps: time steps of exact-LN settings (ripple-rule N).
+        exact_timesteps: time steps of the compiled exact contact (no ring: N does not apply).
     """
     out = [Setting(h, n, contact_mode=m) for m in modes for h in timesteps for n in segments]
     if pair_timestep is not None:
         out += [
             Setting(pair_timestep, None, j, s, "calibrated") for j, s in (("capsule", "capsule"), ("sphere", "box"))
         ]
-    out += [Setting(h, None, contact_mode="exact_ln") for h in exact_timesteps]
+    out += [Setting(h, None, contact_mode="exact") for h in exact_timesteps]
     return tuple(out)
 
 
@@ -81,7 +82,7 @@ def default_scenarios(quick: bool = False) -> list[Scenario]:
             settings_grid(
                 [0.5 * us, 1 * us, 2 * us, 5 * us, 10 * us],
                 pair_timestep=2 * us,
-                exact_timesteps=[1 * us, 2 * us, 5 * us],
+                exact_timesteps=[0.5 * us, 1 * us, 2 * us, 3 * us, 5 * us, 10 * us],
             ),
             blocks=10,
             description="Default slider-crank: c = 0.5 mm at rod_slider, 5000 rpm, no gravity.",
@@ -94,7 +95,7 @@ def default_scenarios(quick: bool = False) -> list[Scenario]:
             settings_grid(
                 [0.5 * us, 1 * us, 2 * us, 5 * us, 10 * us],
                 pair_timestep=2 * us,
-                exact_timesteps=[1 * us, 2 * us, 5 * us],
+                exact_timesteps=[0.5 * us, 1 * us, 2 * us, 3 * us, 5 * us, 10 * us],
             ),
             blocks=10,
             description="Slider-crank, c = 0.1 mm at rod_slider, 5000 rpm, no gravity.",
@@ -108,7 +109,7 @@ def default_scenarios(quick: bool = False) -> list[Scenario]:
                 [1 * us, 2 * us, 5 * us, 10 * us, 20 * us],
                 segments=(36, 72, 144, None),
                 pair_timestep=5 * us,
-                exact_timesteps=[5 * us, 10 * us],
+                exact_timesteps=[2 * us, 5 * us, 10 * us, 20 * us],
             ),
             blocks=6,
             output_interval=5 * us,
@@ -123,7 +124,7 @@ def default_scenarios(quick: bool = False) -> list[Scenario]:
                 [2 * us, 5 * us, 10 * us, 20 * us, 40 * us],
                 segments=(36, 72, 144, None),
                 pair_timestep=10 * us,
-                exact_timesteps=[10 * us, 20 * us],
+                exact_timesteps=[5 * us, 10 * us, 20 * us, 40 * us],
             ),
             blocks=5,
             output_interval=10 * us,

@@ -313,12 +313,12 @@ def timing_task(scenario: Scenario, setting: Setting | None, *, repeats: int = 2
 
 
 def _cost(job: tuple[Scenario, Setting | None]) -> float:
-    """Rough relative cost of an accuracy run: steps, x10 for the Python step loop; references first."""
+    """Rough relative cost of an accuracy run: steps, /2 for the compiled exact contact; references first."""
     sc, st = job
     if st is None:
         return math.inf
-    loop = 10.0 if ContactMode(st.contact_mode) is ContactMode.EXACT_LN else 1.0
-    return sc.revolutions * _period(sc.factory()) / st.timestep * loop
+    ring = 0.5 if ContactMode(st.contact_mode) is ContactMode.EXACT else 1.0
+    return sc.revolutions * _period(sc.factory()) / st.timestep * ring
 
 
 def _todo(out: Path, stage: str, scenarios: Sequence[Scenario]) -> list[tuple[Scenario, Setting | None]]:

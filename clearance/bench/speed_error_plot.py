@@ -16,7 +16,7 @@ from clearance.bench.speed_error_report import SettingRow, pareto_front
 
 __all__ = ["plot_speed_error"]
 
-_COLORS = {"nominal": "tab:blue", "calibrated": "tab:orange", "exact_ln": "tab:green"}
+_COLORS = {"nominal": "tab:blue", "calibrated": "tab:orange", "exact": "tab:green"}
 _MARKERS = {"sphere-sphere": "o", "capsule-capsule": "s", "sphere-box": "^", "cylinder-box": "D"}
 _PANELS = (("statistics_error", "worst statistic error", 0.05), ("first_impact_error", "first-impact error", 0.01))
 

@@ -1,4 +1,9 @@
-"""``clearance mjcf``: write the MuJoCo model (MJCF) of a scenario."""
+"""``clearance mjcf``: write the MuJoCo model (MJCF) of a scenario.
+
+By default it writes the portable ring model (calibrated ring-segment bearings: stock MuJoCo
+opens it anywhere); ``--contact-mode exact`` writes the compiled-contact model, which needs
+this package installed (its plugin loads with ``import mujoco``).
+"""
 
 from __future__ import annotations
 
@@ -9,6 +14,7 @@ from clearance.cli.options import (
     mechanism_from_args,
     options_from_args,
 )
+from clearance.options import ContactMode
 
 __all__ = ["add_parser", "command"]
 
@@ -19,7 +25,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     add_scenario_args(m)
     m.add_argument("--out", default="model.xml", help="MJCF file to write (default model.xml)")
     m.add_argument("--ideal", action="store_true", help="write the ideal twin instead")
-    m.set_defaults(run_command=command)
+    # the portable ring model unless the compiled-contact one is asked for by name
+    m.set_defaults(run_command=command, contact_mode=ContactMode.CALIBRATED.value)
 
 
 def command(args: argparse.Namespace) -> int:

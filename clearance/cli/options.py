@@ -46,7 +46,8 @@ NUMERICS_FLAGS = {
 
 JOURNAL_GEOMS = tuple(g.value for g in GeomType if g is not GeomType.BOX)
 SEGMENT_GEOMS = tuple(g.value for g in GeomType)
-CONTACT_MODES = tuple(m.value for m in ContactMode)
+CONTACT_MODES = (*(m.value for m in ContactMode), "exact_ln")
+"""--contact-mode choices; 'exact_ln' is the earlier name of 'exact'."""
 
 
 _FACTORS = {
@@ -151,11 +152,11 @@ def add_numerics_args(p: argparse.ArgumentParser, *, contact_mode: bool = True) 
             "--contact-mode",
             default=dflt.contact_mode.value,
             choices=CONTACT_MODES,
-            help=f"contact parameters (default {dflt.contact_mode.value}): nominal (formulas), "
-            "calibrated (fitted to LN impacts once, then reused from the cache; see "
-            "'clearance calibrate') or exact_ln (the LN force imposed every step: every "
-            "statistic within 3 %% of the reference on the default scenario, about 10x "
-            "slower; frictionless joints only)",
+            help=f"contact model (default {dflt.contact_mode.value}): exact (each joint's own contact "
+            "law on exact circle geometry, computed by the compiled contact plugin; friction included; "
+            "'exact_ln' is the same), calibrated (a ring of segments whose soft contact is fitted to LN "
+            "impacts once, then reused from the cache; see 'clearance calibrate'; needs no compiler) or "
+            "nominal (the ring with formula parameters)",
         )
 
 

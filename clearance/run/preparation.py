@@ -18,6 +18,9 @@ import numpy as np
 
 from clearance.contact_calibration.effective_mass import cycle_effective_mass
 from clearance.contact_calibration.laws import bearing_stiffness
+from clearance.contact_plugin import PLUGIN_NAME
+from clearance.contact_plugin import require as require_plugin
+from clearance.contact_plugin.attributes import add_for_clearance
 from clearance.loads import joint_reactions
 from clearance.mjcf import (
     BuiltModel,
@@ -29,7 +32,7 @@ from clearance.mjcf import (
 from clearance.model import DriveKind, Joint, Mechanism
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
 
-__all__ = ["JointSizing", "PreparedModel", "prepare", "initial_controls", "TimeStepError"]
+__all__ = ["JointSizing", "PreparedModel", "prepare", "initial_controls", "exact_contact_name", "TimeStepError"]
 
 
 class TimeStepError(ValueError):
@@ -113,6 +116,9 @@ def prepare(
     """
     options = options or ModelOptions()
     cjoints = mechanism.clearance_joints
+    exact = options.contact_mode is ContactMode.EXACT
+    if exact and cjoints:
+        require_plugin()  # before any work: without the compiled plugin this mode cannot run
     loads = joint_reactions(mechanism, _cycle_times(mechanism)) if cjoints else {}
     segs: dict[str, int] = {}
     pre: dict[str, tuple[float, float, float, float]] = {}
@@ -144,23 +150,32 @@ def prepare(
         # before any calibration: a fit at an unstable step fails with a less useful message
         _check_time_step(j.name, sizing[j.name], options.timestep)
     params = dict(contact or {})
-    for j in cjoints:
-        if j.name not in params:
-            params[j.name] = _contact_for(j, built, sizing[j.name], options)
-    apply_contact(built, model, params)
+    if exact:
+        if params:
+            raise ValueError(
+                f"contact parameters were given for {sorted(params)}, but contact_mode 'exact' computes each "
+                "joint's own contact law and takes no ring parameters; use contact_mode 'nominal' or 'calibrated'"
+            )
+        contact_meta = {j.name: _add_exact_contact(built, j) for j in cjoints}
+    else:
+        for j in cjoints:
+            if j.name not in params:
+                params[j.name] = _contact_for(j, built, sizing[j.name], options)
+        apply_contact(built, model, params)
+        contact_meta = {
+            k: {"stiffness_per_row": p.stiffness, "damping_per_row": p.damping, "source": p.source}
+            for k, p in params.items()
+        }
     add_initial_keyframe(built, model, initial_controls(mechanism))
     model = built.spec.compile()
     meta = {
-        "segments": segs,
+        "segments": {} if exact else segs,
         "journal_geom": options.journal_geom.value,
         "segment_geom": options.segment_geom.value,
         "time_step": options.timestep,
         "integrator": options.integrator,
         "contact_mode": options.contact_mode.value,
-        "contact": {
-            k: {"stiffness_per_row": p.stiffness, "damping_per_row": p.damping, "source": p.source}
-            for k, p in params.items()
-        },
+        "contact": contact_meta,
         "sizing": {k: vars(s) for k, s in sizing.items()},
         "stiffness_formula": "K = 4/(3(sigma_B+sigma_J)) sqrt(R_B R_J/(R_B-R_J)), sigma=(1-nu^2)/E",
     }
@@ -170,6 +185,31 @@ def prepare(
 def initial_controls(mechanism: Mechanism) -> np.ndarray:
     """Actuator controls at t = 0: drive speed [rad/s], or torque [N m] for torque drives."""
     return np.array([d.torque if d.kind is DriveKind.TORQUE else float(d.rate(0.0)) for d in mechanism.drives])
+
+
+def exact_contact_name(joint: str) -> str:
+    """Name of a clearance joint's compiled contact (plugin instance and sensor)."""
+    return f"{joint}__contact"
+
+
+def _add_exact_contact(built: BuiltModel, joint: Joint) -> dict[str, Any]:
+    """Add the joint's compiled exact contact to the spec; return its metadata."""
+    c = joint.require_clearance()
+    add_for_clearance(
+        built.spec,
+        c,
+        name=exact_contact_name(joint.name),
+        journal_site=f"{joint.name}__journal",
+        bearing_site=f"{joint.name}__bearing",
+    )
+    return {
+        "law": c.law.value,
+        "stiffness": bearing_stiffness(c),
+        "exponent": 1.5,
+        "restitution": c.restitution,
+        "friction": c.friction,
+        "source": f"exact: compiled plugin {PLUGIN_NAME}",
+    }
 
 
 def _contact_for(joint: Joint, built: BuiltModel, sizing: JointSizing, options: ModelOptions) -> ContactParameters:

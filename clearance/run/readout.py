@@ -9,9 +9,10 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from clearance.contact_plugin.attributes import sensor_offsets
 from clearance.model import OutputKind
 from clearance.results import JointResult, SimulationResult
-from clearance.run.preparation import PreparedModel
+from clearance.run.preparation import PreparedModel, exact_contact_name
 
 __all__ = ["read_sensors", "sensor_slices"]
 
@@ -23,6 +24,20 @@ def sensor_slices(model: mujoco.MjModel) -> dict[str, slice]:
         s = model.sensor(i)
         out[s.name] = slice(int(s.adr[0]), int(s.adr[0] + s.dim[0]))
     return out
+
+
+def _exact_contact_force(sens: np.ndarray, at: dict[str, int], e: np.ndarray) -> np.ndarray:
+    """Contact force on the journal [N], (n, 2) in the bearing frame, as the ring's contact sensor gives it.
+
+    The plugin gives the normal force F_n >= 0 and the tangential force F_t on the journal
+    along t = z x n, n = e/|e|: the force on the journal is -F_n n + F_t t.
+    """
+    r = np.hypot(e[:, 0], e[:, 1])
+    safe = np.where(r > 0, r, 1.0)
+    n = np.where(r[:, None] > 0, e / safe[:, None], np.array([1.0, 0.0]))
+    t = np.stack([-n[:, 1], n[:, 0]], axis=1)
+    fn, ft = sens[:, at["normal_force"]], sens[:, at["tangential_force"]]
+    return -fn[:, None] * n + ft[:, None] * t
 
 
 def _angle(xaxis: np.ndarray) -> np.ndarray:
@@ -72,8 +87,11 @@ def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -
         erate = np.stack(
             [c * dv[:, 0] + s * dv[:, 1] + w * e[:, 1], -s * dv[:, 0] + c * dv[:, 1] - w * e[:, 0]], axis=1
         )
-        fw = get(f"{jname}__force")[:, :2]
-        force = np.stack([c * fw[:, 0] + s * fw[:, 1], -s * fw[:, 0] + c * fw[:, 1]], axis=1)
+        if prepared.built.exact_contact:
+            force = _exact_contact_force(sens, sensor_offsets(model, exact_contact_name(jname)), e)
+        else:
+            fw = get(f"{jname}__force")[:, :2]
+            force = np.stack([c * fw[:, 0] + s * fw[:, 1], -s * fw[:, 0] + c * fw[:, 1]], axis=1)
         pen = np.hypot(e[:, 0], e[:, 1]) - ring.radial_clearance
         joints[jname] = JointResult(e, erate, pen, force)
 

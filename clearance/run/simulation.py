@@ -17,7 +17,7 @@ import numpy as np
 from mujoco import rollout
 
 from clearance.model import DriveKind, Mechanism
-from clearance.options import ContactMode, ContactParameters, ModelOptions
+from clearance.options import ContactParameters, ModelOptions
 from clearance.results import SimulationResult
 from clearance.run.preparation import PreparedModel, prepare
 from clearance.run.readout import read_sensors
@@ -153,10 +153,7 @@ def simulate_prepared(
     nstep = _step_count(duration, h)
     every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
     qpos0 = _initial_qpos(prepared, initial_eccentricity)
-    # exact-LN mode imposes LN on clearance joints' rows; a model without any (the ideal
-    # twin) has nothing to impose and runs in the rollout
-    exact = prepared.options.contact_mode is ContactMode.EXACT_LN and bool(mech.clearance_joints)
-    step = _exact_ln_stepper(prepared, qpos0) if exact else _rollout_stepper(prepared, qpos0)
+    step = _rollout_stepper(prepared, qpos0)
     constant = _constant_controls(mech)
     bar = _progress(progress, nstep)
     parts: list[SimulationResult] = []
@@ -297,51 +294,12 @@ def _first_warning_step(model: mujoco.MjModel, state: np.ndarray, ctrl: np.ndarr
     return k, fired
 
 
-def _exact_ln_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None) -> _Stepper:
-    """Chunks with the exact-LN step loop (LN force imposed on the ring rows each step)."""
-    import copy
-
-    from clearance.contact_calibration.exact_ln import (
-        ExactLNContact,
-        ExactLNStepError,
-        step_exact_ln,
-    )
-
-    model = copy.copy(prepared.model)  # ExactLNContact raises pair margins in place
-    for j in prepared.mechanism.clearance_joints:
-        if j.require_clearance().friction > 0:
-            raise ValueError(
-                f"contact_mode 'exact_ln' supports frictionless joints only (joint '{j.name}' has "
-                f"friction {j.require_clearance().friction}); use 'calibrated'"
-            )
-    contacts = [
-        ExactLNContact(
-            model,
-            j.require_clearance(),
-            prepared.built.rings[j.name],
-            journal_geom=f"{j.name}__journal",
-            bearing_site=f"{j.name}__bearing",
-        )
-        for j in prepared.mechanism.clearance_joints
-    ]
-    data = _start(model, qpos0)
-
-    def step(ctrl: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, mujoco.MjData]:
-        try:
-            run = step_exact_ln(model, data, contacts, n, ctrl=ctrl if len(ctrl) == n else ctrl[0])
-        except ExactLNStepError as err:
-            run = err.partial  # the steps before the failing one
-            raise _StepFailure(np.hstack([run.qpos, run.qvel]), run.sensordata, data, err.reason) from err
-        return np.hstack([run.qpos, run.qvel]), run.sensordata, data
-
-    return step
-
-
 def _remedy(prepared: PreparedModel) -> str:
     h = prepared.options.timestep
-    return (
-        f"use a smaller time step (now {h:g} s, try {h / 2:g} s) or more bearing segments (ModelOptions(segments=...))"
-    )
+    smaller = f"use a smaller time step (now {h:g} s, try {h / 2:g} s)"
+    if prepared.built.exact_contact:
+        return smaller
+    return f"{smaller} or more bearing segments (ModelOptions(segments=...))"
 
 
 def _finish(
