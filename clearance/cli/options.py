@@ -254,6 +254,12 @@ def add_sweep_args(p: argparse.ArgumentParser, command: str) -> None:
     )
     p.add_argument("--segments", type=int, default=None, help="bearing segments N (default: ripple rule)")
     p.add_argument(
+        "--contact-mode",
+        default=ModelOptions().contact_mode.value,
+        choices=CONTACT_MODES,
+        help=f"contact model of every run (default {ModelOptions().contact_mode.value}; see 'clearance run --help')",
+    )
+    p.add_argument(
         "--out", default=None, help=f"output folder (default clearance-{command}-<mechanism>); rerun to resume"
     )
     p.add_argument(
@@ -271,4 +277,4 @@ def sweep_out(args: argparse.Namespace, command: str) -> Path:
 
 def sweep_options(args: argparse.Namespace) -> ModelOptions:
     """`ModelOptions` of a sweep command (its own time-step default; the rest the package's)."""
-    return ModelOptions(timestep=si(args.timestep_us, "us"), segments=args.segments)
+    return ModelOptions(timestep=si(args.timestep_us, "us"), segments=args.segments, contact_mode=args.contact_mode)
