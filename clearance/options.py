@@ -11,7 +11,7 @@ import enum
 import math
 from dataclasses import dataclass
 
-__all__ = ["GeomType", "ContactMode", "ModelOptions", "ContactParameters"]
+__all__ = ["GeomType", "ContactMode", "DEFAULT_TIMESTEP", "ModelOptions", "ContactParameters"]
 
 
 class GeomType(enum.Enum):
@@ -46,6 +46,15 @@ class ContactMode(enum.Enum):
         return cls.EXACT if value == "exact_ln" else None
 
 
+DEFAULT_TIMESTEP: dict[ContactMode, float] = {
+    ContactMode.NOMINAL: 2e-6,
+    ContactMode.CALIBRATED: 2e-6,
+    ContactMode.EXACT: 2e-6,
+}
+"""Each contact mode's default time step [s], chosen from the measured front of speed against
+error (benchmarks/speed_error.md)."""
+
+
 @dataclass(frozen=True)
 class ModelOptions:
     """Numerical choices of a MuJoCo model and run.
@@ -57,9 +66,8 @@ class ModelOptions:
         journal_geom: journal geom type (SPHERE or CAPSULE; CYLINDER uses the convex
             collider).
         segment_geom: bearing segment geom type (SPHERE, CAPSULE, BOX or CYLINDER).
-        timestep: integration time step h [s] (default 2 µs: on the default scenario the
-            first-impact peak is within 5 % of the reference, 0.2 points worse than at
-            1 µs at half the cost; benchmarks/speed_error.md).
+        timestep: integration time step h [s]; 0 (the default) for the contact mode's own
+            default, `DEFAULT_TIMESTEP` (benchmarks/speed_error.md).
         integrator: MuJoCo integrator name ("implicitfast", "euler", "implicit", "rk4").
         contact_mode: how contact parameters are chosen (default CALIBRATED: the lowest
             statistics errors of the two rollout modes over the benchmark scenarios;
@@ -74,7 +82,7 @@ class ModelOptions:
     segments: int | None = None
     journal_geom: GeomType = GeomType.SPHERE
     segment_geom: GeomType = GeomType.SPHERE
-    timestep: float = 2e-6
+    timestep: float = 0.0
     integrator: str = "implicitfast"
     contact_mode: ContactMode = ContactMode.CALIBRATED
     ripple_limit: float = 0.02
@@ -101,6 +109,8 @@ class ModelOptions:
                 raise ValueError(
                     f"contact_mode must be one of {[c.value for c in ContactMode]} (got {self.contact_mode!r})"
                 ) from None
+        if isinstance(self.timestep, (int, float)) and self.timestep == 0:
+            object.__setattr__(self, "timestep", DEFAULT_TIMESTEP[self.contact_mode])
         h = self.timestep
         if not isinstance(h, (int, float)) or not math.isfinite(h) or not 0 < h <= 1e-2:
             raise ValueError(f"timestep must be in (0, 0.01] s (got {h!r})")
@@ -123,14 +133,25 @@ class ContactParameters:
     """Per-segment spring-damper of a clearance joint's contact pairs (physical units).
 
     Attributes:
-        stiffness: normal stiffness of one journal-segment contact row [N/m].
-        damping: normal damping of one contact row [N s/m].
+        stiffness: normal stiffness of one journal-segment contact row [N/m], at full
+            impedance (with ``impedance_rise`` > 0: at row penetrations of the radial
+            clearance and beyond).
+        damping: normal damping of one contact row [N s/m], at full impedance likewise.
         source: where the values come from ("nominal", "calibrated: <file>", ...).
+        impedance_rise: ε [-], the shape of the rows' impedance: each row's solimp is
+            (d(1 − ε), d, c, 0.5, 1), an impedance rising linearly with the row's
+            penetration r from d(1 − ε) at r = 0 to d at r = c (d = `ModelOptions.impedance`,
+            c = the joint's radial clearance). MuJoCo's direct-mode row force is then
+            (d(r)/d)² k r + (d(r)/d) b ṙ, so each row stiffens with its own penetration
+            (`clearance.mjcf.contact.row_solimp`). 0 (the default): the constant impedance d
+            the ring is built with, solimp (d, d, 0.001, 0.5, 2) left as it is. The
+            calibrated mode fits ε (`clearance.contact_calibration.fit`).
     """
 
     stiffness: float
     damping: float
     source: str = "nominal"
+    impedance_rise: float = 0.0
 
     def __post_init__(self) -> None:
         for name in ("stiffness", "damping"):
@@ -139,3 +160,6 @@ class ContactParameters:
                 raise ValueError(f"ContactParameters.{name} must be finite and >= 0 (got {v!r})")
         if self.stiffness == 0:
             raise ValueError("ContactParameters.stiffness must be > 0 (got 0)")
+        eps = self.impedance_rise
+        if not isinstance(eps, (int, float)) or isinstance(eps, bool) or not 0 <= eps < 1:
+            raise ValueError(f"ContactParameters.impedance_rise must be in [0, 1) (got {eps!r})")

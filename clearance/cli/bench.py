@@ -8,6 +8,8 @@ clearance bench --stage report        only rebuild the table and figure from the
 from __future__ import annotations
 
 import argparse
+import dataclasses
+import fnmatch
 import sys
 from collections.abc import Sequence
 
@@ -29,9 +31,21 @@ def bench_parser() -> argparse.ArgumentParser:
         default="all",
         help="accuracy runs (parallel), timing runs (one at a time), report, or all (default)",
     )
+    p.add_argument(
+        "--settings",
+        nargs="+",
+        default=None,
+        metavar="PATTERN",
+        help="only the settings whose key matches one of these shell patterns (e.g. 'exact_*' "
+        "'calibrated_h2us_Nrule_*'; keys as in the output folder's file names); the reference always runs",
+    )
     p.add_argument("--workers", type=int, default=None, help="processes for the accuracy runs (default: CPU count)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     return p
+
+
+def _matches(key: str, patterns: Sequence[str]) -> bool:
+    return any(fnmatch.fnmatchcase(key, p) for p in patterns)
 
 
 def main_bench(argv: Sequence[str] | None = None) -> int:
@@ -45,6 +59,14 @@ def main_bench(argv: Sequence[str] | None = None) -> int:
             print(f"error: unknown scenario(s) {unknown}; choose from {sorted(known)}", file=sys.stderr)
             return 2
         scenarios = [s for s in scenarios if s.name in args.scenarios]
+    if args.settings:
+        scenarios = [
+            dataclasses.replace(s, settings=tuple(st for st in s.settings if _matches(st.key, args.settings)))
+            for s in scenarios
+        ]
+        if not any(s.settings for s in scenarios):
+            print(f"error: --settings {' '.join(args.settings)} matches no setting", file=sys.stderr)
+            return 2
     if args.workers is not None and args.workers < 1:
         print(f"error: --workers must be >= 1 (got {args.workers})", file=sys.stderr)
         return 2

@@ -14,6 +14,7 @@ from clearance.cli.options import (
     options_from_args,
     positive,
 )
+from clearance.options import ContactMode
 
 __all__ = ["calibrate_parser", "main_calibrate"]
 
@@ -29,6 +30,7 @@ def calibrate_parser() -> argparse.ArgumentParser:
         "and numerics.",
     )
     add_scenario_args(p, contact_mode=False)
+    p.set_defaults(contact_mode=ContactMode.CALIBRATED.value)  # a calibration is of the ring, whatever the default
     g = p.add_argument_group("fit")
     g.add_argument(
         "--speeds",

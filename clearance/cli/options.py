@@ -17,7 +17,7 @@ from pathlib import Path
 from typing import TypeVar
 
 from clearance.model import Mechanism
-from clearance.options import ContactMode, GeomType, ModelOptions
+from clearance.options import DEFAULT_TIMESTEP, ContactMode, GeomType, ModelOptions
 from clearance.units import UNITS
 
 __all__ = [
@@ -134,11 +134,12 @@ def add_numerics_args(p: argparse.ArgumentParser, *, contact_mode: bool = True) 
     """Add the MuJoCo numerics group: time step, segments, geoms and (optionally) contact mode."""
     dflt = ModelOptions()
     g = p.add_argument_group("numerics")
+    steps = ", ".join(f"{m.value} {h * 1e6:g}" for m, h in DEFAULT_TIMESTEP.items())
     g.add_argument(
         "--timestep-us",
         type=positive(float, "--timestep-us"),
-        default=dflt.timestep * 1e6,
-        help=f"time step [µs] (default {dflt.timestep * 1e6:g}; see benchmarks/speed_error.md)",
+        default=None,
+        help=f"time step [µs] (default: the contact mode's, {steps}; see benchmarks/speed_error.md)",
     )
     g.add_argument(
         "--segments", type=int, default=None, help="bearing segment count N (default: chosen by the ripple rule)"
@@ -223,7 +224,7 @@ def options_from_args(args: argparse.Namespace) -> ModelOptions:
     mode = getattr(args, "contact_mode", None)  # None for a command without --contact-mode
     return ModelOptions(
         segments=args.segments,
-        timestep=si(args.timestep_us, "us"),
+        timestep=0.0 if args.timestep_us is None else si(args.timestep_us, "us"),  # 0: the mode's default
         journal_geom=GeomType(args.journal_geom),
         segment_geom=GeomType(args.segment_geom),
         contact_mode=ContactMode(mode) if mode else ModelOptions().contact_mode,

@@ -61,7 +61,8 @@ def command(args: argparse.Namespace) -> int:
     atomic_write_text(out / "ideal_model.xml", ideal_prepared.to_xml())
     print(
         f"{mech.name}: clearance at {[j.name for j in mech.clearance_joints]}, "
-        f"{duration * 1e3:.3g} ms at h = {options.timestep:g} s, segments {prepared.metadata['segments']}"
+        f"{duration * 1e3:.3g} ms at h = {options.timestep:g} s, {options.contact_mode.value} contact"
+        + ("" if prepared.built.exact_contact else f", segments {prepared.metadata['segments']}")
     )
     progress = not args.no_progress
     failed = None

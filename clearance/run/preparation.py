@@ -128,12 +128,18 @@ def prepare(
         f = loads[j.name]
         fmed, fmax = float(np.median(f)), float(np.max(f))
         dtyp = (max(fmed, 1e-3 * max(fmax, 1e-9)) / K) ** (2 / 3) if fmax > 0 else 1e-7
-        segs[j.name] = options.segments or choose_segments(
-            c.bearing_radius,
-            c.radial_clearance,
-            dtyp,
-            ripple_limit=options.ripple_limit,
-            flat=options.segment_geom is GeomType.BOX,
+        # the compiled exact contact has no ring: 0 segments
+        segs[j.name] = (
+            0
+            if exact
+            else options.segments
+            or choose_segments(
+                c.bearing_radius,
+                c.radial_clearance,
+                dtyp,
+                ripple_limit=options.ripple_limit,
+                flat=options.segment_geom is GeomType.BOX,
+            )
         )
         pre[j.name] = (K, fmed, fmax, dtyp)
     built = build_spec(mechanism, options, segs)
