@@ -2,6 +2,17 @@
 
 A result saves to ``<stem>.npz`` (arrays) plus ``<stem>.json`` (metadata) and loads back
 losslessly. Both files are written atomically (temporary file, then rename).
+
+Energy balance. A run may carry its energy terms as time series (`SimulationResult.energy`,
+`ENERGY_TERMS`); `energy_residual` closes the balance
+
+    residual = Δkinetic + Δgravity_potential + Δcontact_potential
+               − drive_work − equality_work − contact_work − other_constraint_work − damper_work
+               + dissipated_work
+
+(Δ: change since the first row; works: done ON the mechanism since the first row, so a damper's
+or a contact's work is negative; dissipated_work >= 0 is the energy a compiled contact turned
+into heat). A conservative run has residual 0 up to the integrator's error.
 """
 
 from __future__ import annotations
@@ -15,7 +26,16 @@ from typing import Any
 
 import numpy as np
 
-__all__ = ["JointResult", "SimulationResult", "atomic_write_bytes", "atomic_write_text", "temporary_file_beside"]
+__all__ = [
+    "ENERGY_TERMS",
+    "JointResult",
+    "SimulationResult",
+    "atomic_write_bytes",
+    "atomic_write_text",
+    "energy_balance",
+    "energy_residual",
+    "temporary_file_beside",
+]
 
 
 def temporary_file_beside(path: str | os.PathLike) -> tuple[int, Path]:
@@ -99,6 +119,95 @@ class JointResult:
 
 _JOINT_FIELDS = ("eccentricity", "eccentricity_rate", "penetration", "contact_force")
 
+ENERGY_TERMS: dict[str, str] = {
+    "kinetic": "kinetic energy ½ v'Mv of the links and the drives' armature [J]",
+    "gravity_potential": "gravity (and spring) potential energy [J]",
+    "contact_potential": "elastic energy K δ^(n+1)/(n+1) stored in compiled contacts [J]",
+    "drive_work": "work done by the drives (actuators) on the mechanism since the first row [J]",
+    "equality_work": "work done by equality constraints (connect loop closures) since the first row [J]",
+    "contact_work": "work done by contact constraint rows (ring bearings) since the first row [J]",
+    "other_constraint_work": "work done by other constraint rows (limits, friction loss) since the first row [J]",
+    "damper_work": "work done by dampers, fluid, adhesion, gravity compensation since the first row [J]",
+    "dissipated_work": "work dissipated by compiled contacts (damping, friction) since the first row, >= 0 [J]",
+    "compiled_contact_work": (
+        "work done by compiled contacts' forces since the first row [J] (a check, not a term of the "
+        "residual: it should equal −Δcontact_potential − dissipated_work)"
+    ),
+}
+"""Energy series a result may carry, name -> meaning; each is (n,) [J]."""
+
+_BALANCE_SIGNS: dict[str, float] = {
+    "kinetic": 1.0,
+    "gravity_potential": 1.0,
+    "contact_potential": 1.0,
+    "drive_work": -1.0,
+    "equality_work": -1.0,
+    "contact_work": -1.0,
+    "other_constraint_work": -1.0,
+    "damper_work": -1.0,
+    "dissipated_work": 1.0,
+}
+"""Sign of each term's change in the residual (see the module docstring)."""
+
+
+def energy_residual(energy: dict[str, np.ndarray]) -> np.ndarray | None:
+    """Residual of the energy balance at every row [J], (n,); None when a term is missing.
+
+    Args:
+        energy: the terms of `ENERGY_TERMS` (each (n,) [J]); every term of the balance must be
+            present (`compiled_contact_work` is not one).
+
+    Returns:
+        Σ sign · (term − term[0]) over the balance's terms (signs in the module docstring), or
+        None if ``energy`` lacks one of them.
+    """
+    if any(k not in energy for k in _BALANCE_SIGNS):
+        return None
+    total = np.zeros_like(np.asarray(energy["kinetic"], dtype=float))
+    for k, sign in _BALANCE_SIGNS.items():
+        v = np.asarray(energy[k], dtype=float)
+        total += sign * (v - v[0])
+    return total
+
+
+def energy_balance(energy: dict[str, np.ndarray]) -> dict[str, Any] | None:
+    """Summary of a run's energy balance (JSON-serialisable); None when the run has no energy series.
+
+    Args:
+        energy: the run's energy series (`SimulationResult.energy`).
+
+    Returns:
+        ``change_J``: each term's change from the first row to the last [J] (works: the work
+        done over the run); ``scale_J``: the largest range (max − min) of any term over the run
+        [J], the energy exchanged (an absolute level, like the drives' armature energy or the
+        potential's zero, is arbitrary); ``residual_J``: the residual at the last row;
+        ``residual_max_abs_J``: its largest magnitude over the run; ``residual_relative``: that
+        over ``scale_J``; ``missing``: terms of the balance the run does not have (then the
+        residual entries are None); ``convention``: the formula.
+    """
+    if not energy:
+        return None
+    n = len(next(iter(energy.values())))
+    if n == 0:
+        return None
+    terms = {k: np.asarray(v, dtype=float) for k, v in energy.items()}
+    residual = energy_residual(terms)
+    scale = max(float(np.ptp(v)) for v in terms.values())
+    worst = None if residual is None else float(np.max(np.abs(residual)))
+    return {
+        "change_J": {k: float(v[-1] - v[0]) for k, v in terms.items()},
+        "scale_J": scale,
+        "residual_J": None if residual is None else float(residual[-1]),
+        "residual_max_abs_J": worst,
+        "residual_relative": None if worst is None or scale == 0 else worst / scale,
+        "missing": [k for k in _BALANCE_SIGNS if k not in terms],
+        "convention": (
+            "residual = Δkinetic + Δgravity_potential + Δcontact_potential − drive_work − equality_work "
+            "− contact_work − other_constraint_work − damper_work + dissipated_work (works done on the "
+            "mechanism since the first row)"
+        ),
+    }
+
 
 @dataclass
 class SimulationResult:
@@ -113,7 +222,10 @@ class SimulationResult:
         link_poses: (n, n_links, 3) pose (x [m], y [m], theta [rad]) of each moving link.
         closure_violation: (n,) largest ideal loop-closure error [m] (zeros if none).
         metadata: mechanism name and parameters, solver, time step, segment count, geom
-            types, contact mode and parameters, versions, wall time (JSON-serialisable).
+            types, contact mode and parameters, versions, wall time, the energy balance's
+            summary (``energy_balance``, see `energy_balance`) (JSON-serialisable).
+        energy: name -> (n,) energy series [J] (`ENERGY_TERMS`); empty when the run did not
+            measure them (a model without the energy meter, a result saved before they existed).
     """
 
     times: np.ndarray
@@ -125,9 +237,19 @@ class SimulationResult:
     link_poses: np.ndarray
     closure_violation: np.ndarray
     metadata: dict[str, Any] = field(default_factory=dict)
+    energy: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return len(self.times)
+
+    @property
+    def energy_residual(self) -> np.ndarray | None:
+        """(n,) residual of the energy balance [J] (`energy_residual`), or None without the terms."""
+        return energy_residual(self.energy) if self.energy else None
+
+    def energy_balance(self) -> dict[str, Any] | None:
+        """Summary of the energy balance over the rows of this result (`energy_balance`)."""
+        return energy_balance(self.energy)
 
     @property
     def joint_names(self) -> list[str]:
@@ -146,6 +268,7 @@ class SimulationResult:
             link_poses=self.link_poses[sl],
             closure_violation=self.closure_violation[sl],
             metadata=self.metadata,
+            energy={k: v[sl] for k, v in self.energy.items()},
         )
 
     def decimated(self, every: int) -> SimulationResult:
@@ -174,11 +297,16 @@ class SimulationResult:
             link_poses=cat([p.link_poses for p in parts]),
             closure_violation=cat([p.closure_violation for p in parts]),
             metadata=first.metadata,
+            energy={k: cat([p.energy[k] for p in parts]) for k in first.energy},
         )
 
     # -- persistence --------------------------------------------------------------------
     def save(self, path: str | os.PathLike) -> tuple[Path, Path]:
         """Save to ``<stem>.npz`` and ``<stem>.json``; returns both paths.
+
+        The energy series go into the ``.npz`` (``energy/<term>``); with them, the JSON's
+        ``energy_balance`` is the summary of the saved rows (`energy_balance`), written even if
+        the metadata in memory has none.
 
         Args:
             path: file path; any suffix is replaced.
@@ -199,6 +327,8 @@ class SimulationResult:
         for j, jr in self.joints.items():
             for f in _JOINT_FIELDS:
                 arrays[f"joint/{j}/{f}"] = getattr(jr, f)
+        for k, v in self.energy.items():
+            arrays[f"energy/{k}"] = v
         buf = io.BytesIO()
         # numpy's stubs type **kwds against the allow_pickle keyword (absent before numpy 2.1) too
         np.savez_compressed(buf, **arrays)  # type: ignore[arg-type]
@@ -206,6 +336,10 @@ class SimulationResult:
         meta = dict(self.metadata)
         meta["output_names"] = list(self.outputs)
         meta["joint_names"] = list(self.joints)
+        if self.energy:
+            # the summary always describes the arrays saved beside it
+            meta["energy_balance"] = self.energy_balance()
+            meta["energy_names"] = list(self.energy)
         atomic_write_bytes(npz, buf.getvalue())
         atomic_write_text(js, json.dumps(meta, indent=2, sort_keys=True, default=_json_default))
         return npz, js
@@ -217,6 +351,7 @@ class SimulationResult:
         meta = json.loads(stem.with_suffix(".json").read_text())
         out_names = meta.pop("output_names")
         joint_names = meta.pop("joint_names")
+        energy_names = meta.pop("energy_names", [])  # absent in files saved before energy series existed
         with np.load(stem.with_suffix(".npz"), allow_pickle=False) as z:
             return cls(
                 times=z["times"],
@@ -228,6 +363,7 @@ class SimulationResult:
                 link_poses=z["link_poses"],
                 closure_violation=z["closure_violation"],
                 metadata=meta,
+                energy={k: z[f"energy/{k}"] for k in energy_names},
             )
 
 

@@ -29,6 +29,12 @@ not import mujoco at module level.
 
 Usage: `clearance.contact_plugin.attributes.add_journal_bearing` validates every attribute in
 Python and adds one plugin instance and its sensor to a ``mujoco.MjSpec``.
+
+The same library registers a second plugin, ``clearance.work``: a sensor that integrates the
+work done on a model by each kind of force (actuators, equality and contact constraint rows,
+dampers, plugin passive forces), step by step, so that an energy balance closes from rollout
+sensor rows; `clearance.contact_plugin.energy.add_energy_meter` adds it with MuJoCo's kinetic
+and potential energy sensors.
 """
 
 from __future__ import annotations

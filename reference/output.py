@@ -22,7 +22,7 @@ import numpy as np
 from clearance.kinematics import output_kinematics
 from clearance.reference.integrator import Trajectory
 from clearance.reference.system import ReferenceSystem
-from clearance.results import JointResult, SimulationResult
+from clearance.results import JointResult, SimulationResult, energy_balance
 
 __all__ = ["assemble_result"]
 
@@ -33,7 +33,10 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
     Args:
         system: the system that produced the trajectory.
         traj: the raw solution.
-        metadata: the result's metadata (completed here with energy data if tracked).
+        metadata: the result's metadata (completed here with energy data if tracked: also
+            `SimulationResult.energy` with kinetic, gravity_potential, contact_potential and
+            drive_work (summed over drives), and the ``energy_balance`` summary, whose residual is
+            None: the reference records no constraint or dissipated work).
     """
     n, nq, nc, nd = len(traj.times), system.nq, len(system.contacts), len(system.drives)
     zdd = np.empty((n, nq))
@@ -76,6 +79,7 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
         angle[:, k] = tb - ta
         speed[:, k] = wb - wa
     meta = dict(metadata)
+    energy: dict[str, np.ndarray] = {}
     if traj.work is not None:
         kin, pot, grav = system.energy(traj.z, traj.zd)
         meta["drive_work"] = traj.work.tolist()
@@ -84,6 +88,15 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
             "contact_potential": pot.tolist(),
             "gravity_potential": grav.tolist(),
         }
+        # the terms the reference integrates; it records no constraint or dissipated work (its
+        # joints are exact), so its balance summary lists those as missing and has no residual
+        energy = {
+            "kinetic": np.asarray(kin, dtype=float),
+            "gravity_potential": np.asarray(grav, dtype=float),
+            "contact_potential": np.asarray(pot, dtype=float),
+            "drive_work": np.asarray(traj.work, dtype=float).sum(axis=1),
+        }
+        meta["energy_balance"] = energy_balance(energy)
     meta["max_closure_violation"] = float(closure.max()) if n else 0.0
     return SimulationResult(
         times=np.array(traj.times, dtype=float),
@@ -95,4 +108,5 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
         link_poses=q.reshape(n, len(system.links), 3),
         closure_violation=closure,
         metadata=meta,
+        energy=energy,
     )

@@ -23,9 +23,9 @@ from clearance.analysis.metrics.response import compare_response, contact_modes
 from clearance.analysis.metrics.statistics import deviation_statistics, drive_period
 from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
 from clearance.analysis.sweeps.criticality import CriticalityRanking, ranking_markdown
-from clearance.results import SimulationResult, atomic_write_text
+from clearance.results import ENERGY_TERMS, SimulationResult, atomic_write_text
 
-__all__ = ["write_report", "joint_sections"]
+__all__ = ["write_report", "joint_sections", "energy_section"]
 
 
 def _clearance_of(result: SimulationResult, joint: str) -> float:
@@ -58,6 +58,45 @@ def joint_sections(result: SimulationResult, *, skip: float | None = None) -> di
 
 def _g(v: float) -> str:
     return f"{v:.4g}"
+
+
+def energy_section(result: SimulationResult) -> list[str]:
+    """Markdown lines of the report's "Energy balance" section.
+
+    Args:
+        result: a run; its energy series (`SimulationResult.energy`) may be empty.
+
+    Returns:
+        The section's lines: each term's change over the run [J], the residual at the end and
+        its largest magnitude against the largest energy exchanged, or a line saying why there
+        is no balance.
+    """
+    lines = ["## Energy balance", ""]
+    balance = result.energy_balance()
+    if balance is None:
+        return lines + ["The run carries no energy series (its model had no energy meter).", ""]
+    lines += ["| term | change over the run [J] |", "|---|---:|"]
+    lines += [f"| {k} | {_g(v)} |" for k, v in balance["change_J"].items() if k in ENERGY_TERMS]
+    if balance["residual_J"] is None:
+        return lines + [
+            "",
+            f"No residual: the solver does not record {', '.join(balance['missing'])}.",
+            "",
+        ]
+    rel = balance["residual_relative"]
+    lines += [
+        f"| **residual** | {_g(balance['residual_J'])} |",
+        "",
+        f"Largest |residual| over the run: {_g(balance['residual_max_abs_J'])} J, "
+        f"{'n/a' if rel is None else f'{rel:.2%}'} of the largest energy exchanged ({_g(balance['scale_J'])} J, "
+        "the largest range of any term). Residual = Δkinetic + Δgravity_potential + Δcontact_potential − the works "
+        "done on the mechanism (drive, equality, contact rows, other rows, dampers) + dissipated_work; it is "
+        "the integrator's energy error, first order in the time step. kinetic includes the speed drives' "
+        "armature. A ring bearing's stored energy is in contact_work (its contact_potential is 0); "
+        "compiled_contact_work is a check (−Δcontact_potential − dissipated_work), not a term.",
+        "",
+    ]
+    return lines
 
 
 def write_report(
@@ -186,6 +225,8 @@ def write_report(
         for j in result.joints:
             plots.plot_orbit(result, j, _clearance_of(result, j), path=out / f"orbit_{j}.png")
             lines += [f"![orbit {j}](orbit_{j}.png)", ""]
+
+    lines += energy_section(result)
 
     lines += ["## Phase portraits and Poincaré sections", ""]
     sections = [(output, f"{output}_vel")] + [(f"{j}.ex", f"{j}.ey") for j in result.joints]

@@ -1,7 +1,8 @@
 """Turn a chunk of MuJoCo sensor rows into a `SimulationResult` (vectorised, no per-step Python).
 
 Sensor names are those written by `clearance.mjcf.spec`. With `mujoco.rollout`, sensor
-row i describes the state at t_i = i h (before step i is integrated).
+row i describes the state at t_i = i h (before step i is integrated). A model with the energy
+meter also gets its energy series (`clearance.run.energy`).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ import numpy as np
 from clearance.contact_plugin.attributes import sensor_offsets
 from clearance.model import OutputKind
 from clearance.results import JointResult, SimulationResult
+from clearance.run.energy import read_energy
 from clearance.run.preparation import PreparedModel, exact_contact_name
 
 __all__ = ["read_sensors", "sensor_slices"]
@@ -45,7 +47,11 @@ def _angle(xaxis: np.ndarray) -> np.ndarray:
 
 
 def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -> SimulationResult:
-    """Build a result from sensor rows of shape (n, nsensordata) at ``times`` (n,) [s]."""
+    """Build a result from sensor rows of shape (n, nsensordata) at ``times`` (n,) [s].
+
+    ``times`` are multiples of the time step counted from the run's start (row i of the run at
+    step i): the energy meter's step count is checked against them.
+    """
     mech, model = prepared.mechanism, prepared.model
     if prepared.slices is None:
         prepared.slices = sensor_slices(model)
@@ -112,4 +118,5 @@ def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -
         closure = np.max(np.stack([np.linalg.norm(get(f"{j.name}__closure"), axis=1) for j in cuts]), axis=0)
     else:
         closure = np.zeros(n)
-    return SimulationResult(times, outputs, joints, angle, speed, torque, poses, closure, {})
+    energy = read_energy(prepared, times, sens)
+    return SimulationResult(times, outputs, joints, angle, speed, torque, poses, closure, {}, energy)
