@@ -18,7 +18,8 @@ import numpy as np
 
 from clearance.contact_calibration.effective_mass import cycle_effective_mass
 from clearance.contact_calibration.laws import bearing_stiffness
-from clearance.contact_plugin import PLUGIN_NAME
+from clearance.contact_plugin import PLUGIN_NAME, is_available
+from clearance.contact_plugin.energy import add_energy_meter
 from clearance.contact_plugin import require as require_plugin
 from clearance.contact_plugin.attributes import add_for_clearance
 from clearance.loads import joint_reactions
@@ -173,7 +174,12 @@ def prepare(
             for k, p in params.items()
         }
     add_initial_keyframe(built, model, initial_controls(mechanism))
-    model = built.spec.compile()
+    # the run's model carries the energy meter; the spec (what to_xml writes) stays portable
+    run_spec = built.spec
+    if is_available():
+        run_spec = built.spec.copy()
+        add_energy_meter(run_spec)
+    model = run_spec.compile()
     meta = {
         "segments": {} if exact else segs,
         "journal_geom": options.journal_geom.value,

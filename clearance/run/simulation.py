@@ -323,6 +323,7 @@ def _finish(
         "mujoco_version": mujoco.__version__,
         "package_version": __version__,
     }
+    res.metadata["energy_balance"] = res.energy_balance()
     return res
 
 
