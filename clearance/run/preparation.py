@@ -19,9 +19,9 @@ import numpy as np
 from clearance.contact_calibration.effective_mass import cycle_effective_mass
 from clearance.contact_calibration.laws import bearing_stiffness
 from clearance.contact_plugin import PLUGIN_NAME, is_available
-from clearance.contact_plugin.energy import add_energy_meter
 from clearance.contact_plugin import require as require_plugin
 from clearance.contact_plugin.attributes import add_for_clearance
+from clearance.contact_plugin.energy import add_energy_meter
 from clearance.loads import joint_reactions
 from clearance.mjcf import (
     BuiltModel,
