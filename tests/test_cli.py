@@ -100,11 +100,17 @@ def test_run_contact_mode_option(tmp_path, capsys):
     import json
 
     out = tmp_path / "out"
-    # the default is calibrated (benchmarks/speed_error.md); 0.3 ms covers the start of the
-    # first impact and stays fast
+    # the default is the compiled exact contact at 3 us (benchmarks/speed_error.md); 0.3 ms covers
+    # the start of the first impact and stays fast
     assert main(["run", "--duration-ms", "0.3", "--out", str(out), "--no-progress"]) == 0
     meta = json.loads((out / "result.json").read_text())
-    assert meta["contact_mode"] == "calibrated"
+    assert meta["contact_mode"] == "exact" and meta["time_step"] == 3e-6
+    assert meta["contact"]["rod_slider"]["source"].startswith("exact: compiled plugin")
+    assert (
+        main(["run", "--contact-mode", "calibrated", "--duration-ms", "0.3", "--out", str(out), "--no-progress"]) == 0
+    )
+    meta = json.loads((out / "result.json").read_text())
+    assert meta["contact_mode"] == "calibrated" and meta["time_step"] == 2e-6  # the ring's own default step
     assert meta["contact"]["rod_slider"]["source"].startswith("calibrated: ")
     assert main(["run", "--contact-mode", "nominal", "--duration-ms", "0.3", "--out", str(out), "--no-progress"]) == 0
     meta = json.loads((out / "result.json").read_text())

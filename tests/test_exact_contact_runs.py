@@ -68,3 +68,27 @@ def test_exact_mode_is_refused_cleanly_without_the_compiled_plugin(monkeypatch):
     monkeypatch.setattr(plugin, "is_available", lambda: False)
     with pytest.raises(plugin.PluginUnavailableError, match="calibrated"):
         simulate(slider_crank(), duration=1e-4, options=EXACT)
+
+
+def test_the_default_command_falls_back_to_the_ring_without_the_plugin(monkeypatch, tmp_path, capsys):
+    # installed without a C compiler: `clearance run` (no --contact-mode) runs the calibrated
+    # ring and says so once; asked for --contact-mode exact, it is refused before any work
+    import json
+
+    import clearance.cli.options as cli_options
+    from clearance.cli import main
+
+    monkeypatch.setattr(cli_options, "plugin_available", lambda: False)
+    out = tmp_path / "out"
+    assert main(["run", "--duration-ms", "0.1", "--out", str(out), "--no-progress"]) == 0
+    assert json.loads((out / "result.json").read_text())["contact_mode"] == "calibrated"
+    assert capsys.readouterr().err.count("compiled contact plugin is not installed") == 1
+
+    import clearance.contact_plugin as plugin
+
+    monkeypatch.setattr(plugin, "is_available", lambda: False)
+    monkeypatch.setattr(plugin, "library_path", lambda: None)
+    argv = ["run", "--contact-mode", "exact", "--duration-ms", "0.1", "--out", str(tmp_path / "x"), "--no-progress"]
+    assert main(argv) == 2  # a usage error, no traceback
+    assert "--contact-mode calibrated" in capsys.readouterr().err  # the message names the way out
+    assert not (tmp_path / "x").exists()  # refused before any output

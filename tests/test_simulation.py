@@ -156,7 +156,12 @@ def test_time_step_halving_first_impact_peak(default_prepared):
     assert params["rod_slider"].source == "nominal"
     peaks = []
     for h in (1e-6, 0.5e-6):
-        r = simulate(mech, duration=0.5e-3, options=ModelOptions(timestep=h, segments=144), contact=params)
+        r = simulate(
+            mech,
+            duration=0.5e-3,
+            options=ModelOptions(timestep=h, segments=144, contact_mode="nominal"),
+            contact=params,
+        )
         peaks.append(r.joints["rod_slider"].force_magnitude.max())
     # the first impact lasts ~30 us; sampling its peak at 1 us costs up to ~0.5 % and the
     # integrator error at omega*h ~ 0.1 is smaller (measured 0.07 %)
@@ -176,7 +181,7 @@ def test_divergence_names_time_joint_and_keeps_partial():
 
     soft = {"rod_slider": ContactParameters(stiffness=1e3, damping=0.0)}
     with pytest.raises(SimulationError) as info:
-        simulate(slider_crank(), duration=3e-3, contact=soft, options=ModelOptions(segments=36))
+        simulate(slider_crank(), duration=3e-3, contact=soft, options=ModelOptions(segments=36, contact_mode="nominal"))
     err = info.value
     assert err.joint == "rod_slider" and err.time is not None
     assert "Remedy" in str(err)
@@ -199,7 +204,12 @@ def test_non_finite_or_warning_stops_at_the_first_bad_step(stiffness, reason):
     absurd = {"rod_slider": ContactParameters(stiffness=stiffness, damping=0.0)}
     with pytest.raises(SimulationError) as info:
         # one chunk of 500 steps: the bad step lies inside it, not at its end
-        simulate(slider_crank(), duration=duration, contact=absurd, options=ModelOptions(segments=36, timestep=h))
+        simulate(
+            slider_crank(),
+            duration=duration,
+            contact=absurd,
+            options=ModelOptions(segments=36, timestep=h, contact_mode="nominal"),
+        )
     err = info.value
     assert reason in str(err) and "Remedy: use a smaller time step" in str(err)
     assert f"diverged at t = {err.time:.6g} s:" in str(err)
@@ -227,7 +237,7 @@ def test_exact_ln_step_failure_carries_the_steps_before_it():
     )
     from clearance.run.preparation import prepare
 
-    p = prepare(slider_crank(), ModelOptions(segments=36))
+    p = prepare(slider_crank(), ModelOptions(segments=36, contact_mode="nominal"))  # the ring the step loop drives
     model = copy.copy(p.model)
     j = p.mechanism.clearance_joints[0]
     contact = ExactLNContact(

@@ -19,6 +19,7 @@ import importlib
 import sys
 from collections.abc import Callable
 
+from clearance.contact_plugin import PluginUnavailableError
 from clearance.kinematics import AssemblyError
 
 __all__ = ["main", "build_parser"]
@@ -69,7 +70,7 @@ def main(argv: list[str] | None = None) -> int:
     command: Callable[[argparse.Namespace], int] = args.run_command
     try:
         return command(args)
-    except (ValueError, AssemblyError) as err:
+    except (ValueError, AssemblyError, PluginUnavailableError) as err:
         print(f"error: {err}", file=sys.stderr)
         return 2
 

@@ -12,10 +12,12 @@ from __future__ import annotations
 import argparse
 import inspect
 import math
+import sys
 from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
 
+from clearance.contact_plugin import is_available as plugin_available
 from clearance.model import Mechanism
 from clearance.options import DEFAULT_TIMESTEP, ContactMode, GeomType, ModelOptions
 from clearance.units import UNITS
@@ -28,6 +30,7 @@ __all__ = [
     "add_sweep_args",
     "sweep_out",
     "sweep_options",
+    "contact_mode_from_args",
     "add_scenario_args",
     "add_numerics_args",
     "mechanism_from_args",
@@ -151,7 +154,7 @@ def add_numerics_args(p: argparse.ArgumentParser, *, contact_mode: bool = True) 
     if contact_mode:
         g.add_argument(
             "--contact-mode",
-            default=dflt.contact_mode.value,
+            default=None,
             choices=CONTACT_MODES,
             help=f"contact model (default {dflt.contact_mode.value}): exact (each joint's own contact "
             "law on exact circle geometry, computed by the compiled contact plugin; friction included; "
@@ -221,13 +224,13 @@ def options_from_args(args: argparse.Namespace) -> ModelOptions:
     Raises:
         ValueError: a value `ModelOptions` rejects (it names the field).
     """
-    mode = getattr(args, "contact_mode", None)  # None for a command without --contact-mode
+    mode = contact_mode_from_args(args)
     return ModelOptions(
         segments=args.segments,
         timestep=0.0 if args.timestep_us is None else si(args.timestep_us, "us"),  # 0: the mode's default
         journal_geom=GeomType(args.journal_geom),
         segment_geom=GeomType(args.segment_geom),
-        contact_mode=ContactMode(mode) if mode else ModelOptions().contact_mode,
+        contact_mode=mode,
     )
 
 
@@ -256,7 +259,7 @@ def add_sweep_args(p: argparse.ArgumentParser, command: str) -> None:
     p.add_argument("--segments", type=int, default=None, help="bearing segments N (default: ripple rule)")
     p.add_argument(
         "--contact-mode",
-        default=ModelOptions().contact_mode.value,
+        default=None,
         choices=CONTACT_MODES,
         help=f"contact model of every run (default {ModelOptions().contact_mode.value}; see 'clearance run --help')",
     )
@@ -278,4 +281,29 @@ def sweep_out(args: argparse.Namespace, command: str) -> Path:
 
 def sweep_options(args: argparse.Namespace) -> ModelOptions:
     """`ModelOptions` of a sweep command (its own time-step default; the rest the package's)."""
-    return ModelOptions(timestep=si(args.timestep_us, "us"), segments=args.segments, contact_mode=args.contact_mode)
+    return ModelOptions(
+        timestep=si(args.timestep_us, "us"), segments=args.segments, contact_mode=contact_mode_from_args(args)
+    )
+
+
+def contact_mode_from_args(args: argparse.Namespace) -> ContactMode:
+    """The contact mode asked for, or the package's default.
+
+    The default is the compiled exact contact. Where the package was installed without a C
+    compiler its plugin is missing: a command that was not asked for a contact mode then runs
+    the calibrated ring and says so once on stderr; one asked for ``--contact-mode exact`` is
+    refused before any work (`clearance.contact_plugin.PluginUnavailableError`).
+    """
+    given = getattr(args, "contact_mode", None)
+    if given is not None:
+        return ContactMode(given)
+    mode = ModelOptions().contact_mode
+    if mode is ContactMode.EXACT and not plugin_available():
+        print(
+            "warning: the compiled contact plugin is not installed (the package was installed without a C "
+            "compiler), so this runs the calibrated ring instead of the exact contact; install a C compiler "
+            "and reinstall the package for the exact contact",
+            file=sys.stderr,
+        )
+        return ContactMode.CALIBRATED
+    return mode
