@@ -73,6 +73,16 @@ def accuracy_table(rows: Sequence[SpeedRow]) -> str:
     return head + "\n".join(lines) + "\n"
 
 
+def _solimp_text(eps: float, options: ModelOptions, clearance: Clearance) -> str:
+    d = options.impedance
+    if eps == 0:
+        return f"solimp ({d:g}, {d:g}, 0.001, 0.5, 2) as built (constant impedance)"
+    return (
+        f"solimp ({d * (1 - eps):.4g}, {d:g}, {clearance.radial_clearance:g}, 0.5, 1): the row impedance "
+        f"rises linearly from d(1 − ε) at zero penetration to d at the clearance"
+    )
+
+
 def _markdown(
     result: CalibrationResult,
     clearance: Clearance,
@@ -92,8 +102,9 @@ def _markdown(
         f"segments, time step {options.timestep * 1e6:g} µs, {options.integrator}, impedance {options.impedance:g}\n"
         f"- Effective mass {result.mass:.5g} kg (valid range {lo:.5g}–{hi:.5g} kg)\n"
         f"- Fitted per-row stiffness {p.stiffness:.6g} N/m, damping {p.damping:.6g} N·s/m "
+        f"(at full impedance), impedance rise ε = {p.impedance_rise:.4f} "
         f"(nominal start {result.initial.stiffness:.6g} N/m, {result.initial.damping:.6g} N·s/m); "
-        f"emitted as direct-mode solref (−k·Â, −b·Â), solimp unchanged\n"
+        f"emitted as direct-mode solref (−k·Â, −b·Â) and {_solimp_text(p.impedance_rise, options, clearance)}\n"
         f"- Stability at δ = {s.penetration * 1e6:.3g} µm: ω·h = {s.omega_h:.3f} (< 2), "
         f"h²ω² + 2hβ = {s.damped_bound:.3f} (< 4)\n"
         f"- Fit: {result.nfev} MuJoCo evaluations, {result.wall_time:.2f} s; MuJoCo {result.meta.get('mujoco')}\n"

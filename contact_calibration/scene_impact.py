@@ -1,10 +1,12 @@
 """Radial impacts of a journal on its ring in the one-bearing MuJoCo scene.
 
-The scene is `clearance.mjcf.probe.ring_scene`: the bearing ring fixed to the world and a
-journal of mass m on slide x / slide y, with the joint's geoms, segment count, time step and
-per-row contact parameters. A journal starts two steps before first contact with normal
-speed v along a direction ψ (toward a segment, ψ = 0, or between two segments, ψ = π/N)
-and is stepped with `mujoco.rollout` until well after separation.
+The scene (`impact_scene`) is `clearance.mjcf.probe.ring_scene`: the bearing ring fixed to
+the world and a journal of mass m on slide x / slide y, with the joint's geoms, segment
+count, time step and per-row contact parameters, the impedance shape included (the rows'
+solimp as `clearance.mjcf.contact.apply_contact` writes it into a run's model). A journal
+starts two steps before first contact with normal speed v along a direction ψ (toward a
+segment, ψ = 0, or between two segments, ψ = π/N) and is stepped with `mujoco.rollout`
+until well after separation.
 
 Measured quantities, chosen to be the ones a clearance run reports:
   * penetration δ = |e| − c (exact circle geometry, as in `SimulationResult`); its maximum
@@ -28,8 +30,11 @@ import mujoco.rollout
 import numpy as np
 
 from clearance.mjcf.bearing import RingGeometry, segment_centres
+from clearance.mjcf.contact import row_solimp
+from clearance.mjcf.probe import ring_scene
+from clearance.options import ContactParameters, ModelOptions
 
-__all__ = ["SceneImpact", "ring_gap", "onset_radius", "scene_impacts", "DEFAULT_DIRECTIONS"]
+__all__ = ["SceneImpact", "impact_scene", "ring_gap", "onset_radius", "scene_impacts", "DEFAULT_DIRECTIONS"]
 
 DEFAULT_DIRECTIONS = (0.0, 0.5)
 """Impact directions as fractions of the segment pitch 2π/N: at a segment, between two."""
@@ -62,6 +67,35 @@ class SceneImpact:
     max_penetration: float
     duration: float
     restitution: float
+
+
+def impact_scene(
+    ring: RingGeometry,
+    options: ModelOptions,
+    params: ContactParameters,
+    *,
+    mass: float,
+    friction: float = 0.0,
+) -> mujoco.MjModel:
+    """The compiled one-bearing scene with ``params`` as a run's model gets them.
+
+    `clearance.mjcf.probe.ring_scene` (solref (−k Â, −b Â)) with the rows' solimp of
+    `clearance.mjcf.contact.row_solimp` when ``params.impedance_rise`` > 0 (full impedance
+    d = ``options.impedance``, width the ring's radial clearance), as `apply_contact` writes
+    them into a run's pairs: the fit measures what the run does.
+
+    Args:
+        ring: ring geometry.
+        options: model options (geoms, time step, impedance).
+        params: per-row contact parameters.
+        mass: journal mass [kg].
+        friction: the clearance's friction coefficient [-].
+    """
+    model = ring_scene(ring, options, params, mass=mass, friction=friction)
+    solimp = row_solimp(params, options.impedance, ring.radial_clearance)
+    if solimp is not None:
+        model.pair_solimp[:] = solimp
+    return model
 
 
 def ring_gap(ring: RingGeometry, position: np.ndarray) -> np.ndarray:

@@ -18,6 +18,7 @@ that cannot be written is reported the same way; the fit is then used without be
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import json
 import math
@@ -174,7 +175,7 @@ def calibration_path(key: dict[str, Any], directory: Path | None = None) -> Path
 
 def _validate(result: CalibrationResult) -> None:
     p = result.parameters
-    values = [p.stiffness, p.damping, result.mass, *result.mass_range]
+    values = [p.stiffness, p.damping, p.impedance_rise, result.mass, *result.mass_range]
     if not all(isinstance(v, float) and math.isfinite(v) for v in values) or p.stiffness <= 0:
         raise ValueError("non-finite or non-positive parameters")
 
@@ -353,12 +354,12 @@ def calibrated_parameters(joint: Joint, ring: RingGeometry, sizing: Sizing, opti
         options: model options.
 
     Returns:
-        ContactParameters with source ``"calibrated: <file>"`` (``"calibrated: not
-        cached"`` when the cache folder could not be written).
+        The fitted ContactParameters (stiffness, damping and impedance rise) with source
+        ``"calibrated: <file>"`` (``"calibrated: not cached"`` when the cache folder could
+        not be written).
 
     Raises:
         CalibrationStabilityError: the fitted contact is unstable at the time step.
     """
     result, path = calibrate_joint(joint, ring, sizing, options)
-    p = result.parameters
-    return ContactParameters(p.stiffness, p.damping, f"calibrated: {path or 'not cached'}")
+    return dataclasses.replace(result.parameters, source=f"calibrated: {path or 'not cached'}")

@@ -93,6 +93,13 @@ def segment_centres(geom: RingGeometry) -> np.ndarray:
     return r * np.stack([np.cos(phi), np.sin(phi)], axis=1)
 
 
+def _impedance_factor(geom: RingGeometry, pen: np.ndarray, impedance_rise: float) -> np.ndarray | float:
+    """d(r)/d of rows at penetrations ``pen`` [m]: 1 − ε + ε min(r/c, 1) (1 for ε = 0)."""
+    if not impedance_rise:
+        return 1.0
+    return 1.0 - impedance_rise + impedance_rise * np.minimum(pen / geom.radial_clearance, 1.0)
+
+
 def ring_force(
     geom: RingGeometry,
     eccentricity: np.ndarray,
@@ -100,15 +107,19 @@ def ring_force(
     stiffness: float = 1.0,
     damping: float = 0.0,
     eccentricity_rate: np.ndarray | None = None,
+    impedance_rise: float = 0.0,
 ) -> np.ndarray:
     """Net force on the journal from a ring of linear spring-dampers.
 
     Args:
         geom: ring geometry.
         eccentricity: (..., 2) journal centre in the bearing frame [m].
-        stiffness: per contact row [N/m].
-        damping: per contact row [N s/m].
+        stiffness: per contact row [N/m] (at full impedance).
+        damping: per contact row [N s/m] (at full impedance).
         eccentricity_rate: (..., 2) journal-centre velocity [m/s] (needed with damping).
+        impedance_rise: ε of `ContactParameters.impedance_rise`: a row at penetration r
+            pushes with g² k r + g b ṙ, g = 1 − ε + ε min(r/c, 1) (MuJoCo's direct-mode row
+            with solimp (d(1 − ε), d, c, 0.5, 1)); 0: plain linear rows.
 
     Returns:
         (..., 2) force on the journal [N] (each row pushes only: no adhesion).
@@ -120,11 +131,12 @@ def ring_force(
     n = d / dist[..., None]
     pen = geom.journal_radius + geom.segment_radius - dist
     active = pen > 0
-    f = stiffness * np.where(active, pen, 0.0)
+    g = _impedance_factor(geom, np.where(active, pen, 0.0), impedance_rise)
+    f = g**2 * stiffness * np.where(active, pen, 0.0)
     if damping and eccentricity_rate is not None:
         v = np.asarray(eccentricity_rate, dtype=float)
         pen_rate = -(n * v[..., None, :]).sum(-1)
-        f = f + np.where(active, damping * pen_rate, 0.0)
+        f = f + np.where(active, g * damping * pen_rate, 0.0)
         f = np.maximum(f, 0.0)
     f = f * geom.contacts_per_pair
     return (f[..., None] * n).sum(-2)
@@ -156,13 +168,14 @@ def ring_stiffness_coefficient(
     return float(np.exp(np.mean(np.log(f) - 1.5 * np.log(deltas))))
 
 
-def ring_damping_coefficient(geom: RingGeometry, delta: float) -> float:
+def ring_damping_coefficient(geom: RingGeometry, delta: float, *, impedance_rise: float = 0.0) -> float:
     """Radial damping of the ring at depth ``delta`` for unit row damping [N s/m per N s/m].
 
     Sum of cos^2 of the active rows' normals about the radial direction (averaged over
     journal direction): the ring's damping grows like sqrt(delta) while LN's grows like
     delta^1.5, which is why one constant row damping matches LN restitution at one impact
-    speed only.
+    speed only. With ``impedance_rise`` ε each row's term is weighted by its d(r)/d (see
+    `ring_force`).
     """
     psi = np.linspace(0.0, 2 * np.pi / geom.segments, 16, endpoint=False)
     s = segment_centres(geom)
@@ -172,9 +185,10 @@ def ring_damping_coefficient(geom: RingGeometry, delta: float) -> float:
         e = (geom.radial_clearance + delta) * u
         d = e - s
         dist = np.linalg.norm(d, axis=1)
-        act = geom.journal_radius + geom.segment_radius - dist > 0
+        pen = geom.journal_radius + geom.segment_radius - dist
+        act = pen > 0
         cos = (d[act] / dist[act, None]) @ u
-        tot += float(np.sum(cos**2))
+        tot += float(np.sum(_impedance_factor(geom, pen[act], impedance_rise) * cos**2))
     return tot / len(psi) * geom.contacts_per_pair
 
 

@@ -5,6 +5,12 @@ spring-damper of physical stiffness S / A_hat and damping D / A_hat per contact 
 A_hat is the row's approximate inverse inertia (the sum of the two bodies'
 ``body_invweight0`` translational terms, frozen at qpos0) (MUJOCO_NOTES.md, re-measured in
 tests/test_mjcf.py). So a physical per-row stiffness k is written as S = k A_hat.
+
+The impedance may rise with each row's penetration r instead (`ContactParameters.impedance_rise`
+ε > 0): solimp (d(1 − ε), d, c, 0.5, 1), linear from d(1 − ε) at r = 0 to d at r = c, the
+radial clearance. MuJoCo's direct-mode row force is then (d(r)/d)² k r + (d(r)/d) b ṙ, so the
+row stiffens with its own penetration (benchmarks/ring_bounded_try.md); k and b are the
+values at full impedance, r >= c.
 """
 
 from __future__ import annotations
@@ -15,7 +21,14 @@ import numpy as np
 from clearance.mjcf.spec import BuiltModel
 from clearance.options import ContactParameters
 
-__all__ = ["apply_contact", "row_inverse_weight", "effective_masses", "initial_velocity", "add_initial_keyframe"]
+__all__ = [
+    "apply_contact",
+    "row_solimp",
+    "row_inverse_weight",
+    "effective_masses",
+    "initial_velocity",
+    "add_initial_keyframe",
+]
 
 
 def _body_id(model: mujoco.MjModel, name: str) -> int:
@@ -30,10 +43,31 @@ def row_inverse_weight(model: mujoco.MjModel, built: BuiltModel, joint: str) -> 
     return float(model.body_invweight0[jb, 0] + model.body_invweight0[bb, 0])
 
 
-def apply_contact(built: BuiltModel, model: mujoco.MjModel, params: dict[str, ContactParameters]) -> None:
-    """Write each clearance joint's per-row stiffness and damping into its pairs.
+def row_solimp(params: ContactParameters, impedance: float, width: float) -> list[float] | None:
+    """The contact rows' solimp for ``params``, or None to keep the constant impedance as built.
 
-    Updates both the compiled ``model`` (in place) and ``built.spec`` (for MJCF output).
+    Args:
+        params: the per-row contact parameters (``impedance_rise`` ε is used).
+        impedance: the full impedance d (`ModelOptions.impedance`) [-].
+        width: the penetration at which the impedance reaches d [m]: the radial clearance.
+
+    Returns:
+        ``[d(1 − ε), d, width, 0.5, 1]`` (power 1: linear in the row's penetration), or None
+        for ε = 0.
+    """
+    eps = params.impedance_rise
+    if eps == 0:
+        return None
+    return [impedance * (1.0 - eps), impedance, float(width), 0.5, 1.0]
+
+
+def apply_contact(built: BuiltModel, model: mujoco.MjModel, params: dict[str, ContactParameters]) -> None:
+    """Write each clearance joint's per-row stiffness, damping and impedance shape into its pairs.
+
+    solref gets (-k Â, -b Â); with ``impedance_rise`` > 0 solimp gets `row_solimp` (the full
+    impedance d read from the pair as built, the width the joint's radial clearance), else
+    the pair's solimp is left as built. Updates both the compiled ``model`` (in place) and
+    ``built.spec`` (for MJCF output).
     """
     pairs = {p.name: p for p in built.spec.pairs}
     for joint, p in params.items():
@@ -44,6 +78,10 @@ def apply_contact(built: BuiltModel, model: mujoco.MjModel, params: dict[str, Co
             pid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, name)
             model.pair_solref[pid] = solref
             pairs[name].solref = solref
+            solimp = row_solimp(p, float(pairs[name].solimp[1]), built.rings[joint].radial_clearance)
+            if solimp is not None:
+                model.pair_solimp[pid] = solimp
+                pairs[name].solimp = solimp
 
 
 def effective_masses(model: mujoco.MjModel, built: BuiltModel) -> dict[str, float]:
