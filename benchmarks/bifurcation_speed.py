@@ -66,7 +66,9 @@ def main() -> None:
     p.add_argument("--points", type=int, default=200)
     p.add_argument("--timestep-us", type=float, default=5.0)
     p.add_argument("--segments", type=int, default=None)
-    p.add_argument("--contact-mode", default=ModelOptions().contact_mode.value, choices=("nominal", "calibrated"))
+    p.add_argument(
+        "--contact-mode", default=ModelOptions().contact_mode.value, choices=("nominal", "calibrated", "exact")
+    )
     p.add_argument("--workers", type=int, default=2)
     p.add_argument("--periods", type=int, default=60)
     p.add_argument("--sampled", type=int, default=40)

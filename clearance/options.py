@@ -49,7 +49,7 @@ class ContactMode(enum.Enum):
 DEFAULT_TIMESTEP: dict[ContactMode, float] = {
     ContactMode.NOMINAL: 2e-6,
     ContactMode.CALIBRATED: 2e-6,
-    ContactMode.EXACT: 2e-6,
+    ContactMode.EXACT: 3e-6,
 }
 """Each contact mode's default time step [s], chosen from the measured front of speed against
 error (benchmarks/speed_error.md)."""
@@ -69,9 +69,11 @@ class ModelOptions:
         timestep: integration time step h [s]; 0 (the default) for the contact mode's own
             default, `DEFAULT_TIMESTEP` (benchmarks/speed_error.md).
         integrator: MuJoCo integrator name ("implicitfast", "euler", "implicit", "rk4").
-        contact_mode: how contact parameters are chosen (default CALIBRATED: the lowest
-            statistics errors of the two rollout modes over the benchmark scenarios;
-            EXACT_LN for accuracy at about ten times the cost; benchmarks/speed_error.md).
+        contact_mode: the contact model (default EXACT, the compiled exact contact: first
+            impacts within 0.3 % of the reference and the benchmark's statistics within the
+            reference's own scatter on three of its four scenarios, at 3 µs and 25x the
+            reference's speed; CALIBRATED, the portable ring, needs no compiled plugin;
+            benchmarks/speed_error.md).
         ripple_limit: largest force ripple allowed by the segment-count rule [-].
         impedance: constant solimp impedance d of the contact rows (small: the contact
             then behaves as a plain spring-damper; MUJOCO_NOTES.md).
@@ -84,7 +86,7 @@ class ModelOptions:
     segment_geom: GeomType = GeomType.SPHERE
     timestep: float = 0.0
     integrator: str = "implicitfast"
-    contact_mode: ContactMode = ContactMode.CALIBRATED
+    contact_mode: ContactMode = ContactMode.EXACT
     ripple_limit: float = 0.02
     impedance: float = 1e-3
     closure_timeconst: float | None = None
