@@ -96,7 +96,10 @@ def test_every_cli_geom_pair_touches_and_steps_without_warnings(pair):
     from clearance.run.initial_state import offset_journals
 
     mech = slider_crank(clearance_at=("crank_rod", "rod_slider"), crank_speed=200 * 2 * np.pi / 60)
-    xml = prepare(mech, ModelOptions(segments=36, journal_geom=pair[0], segment_geom=pair[1], timestep=2e-6)).to_xml()
+    xml = prepare(
+        mech,
+        ModelOptions(segments=36, journal_geom=pair[0], segment_geom=pair[1], timestep=2e-6, contact_mode="calibrated"),
+    ).to_xml()
     model = mujoco.MjModel.from_xml_string(xml)
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
@@ -140,7 +143,11 @@ def test_physical_row_stiffness_mapping():
     # re-measures MUJOCO_NOTES.md: physical stiffness = S / A_hat with a small impedance
     mech = slider_crank(clearance_at=("rod_slider",), crank_speed=1e-3)
     k = 2.0e7
-    prep = prepare(mech, ModelOptions(segments=72, timestep=1e-6), contact={"rod_slider": ContactParameters(k, 0.0)})
+    prep = prepare(
+        mech,
+        ModelOptions(segments=72, timestep=1e-6, contact_mode="nominal"),
+        contact={"rod_slider": ContactParameters(k, 0.0)},
+    )
     model = prep.model
     pid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, "rod_slider__pair000")
     data = mujoco.MjData(model)
