@@ -96,6 +96,8 @@ def read_energy(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) ->
         return {}
     at = energy_sensor_addresses(model)
     steps = np.rint(times / model.opt.timestep)
+    if not np.isfinite(sens).all():
+        return {}  # a diverged chunk: the run stops with its own error, the balance means nothing there
     if not np.array_equal(sens[:, at["steps"]], steps):
         warnings.warn(
             "the energy meter did not record every step (were sensors disabled?): no energy series",
