@@ -31,6 +31,13 @@ class JointSummary:
         max_penetration: largest penetration [m].
         output_rms_deviation: RMS of (output - ideal output) of the first output [m or
             rad] (NaN without an ideal result).
+        startup_window: the start-up window [s] (the first period of the slowest prescribed
+            drive): the ``steady_*`` values are taken after it; 0 when none was asked for.
+        steady_peak_force, steady_p95_force, steady_impacts, steady_contact_fraction,
+            steady_max_penetration: the same statistics over the steady state only (after
+            the start-up window, where the journal released from the bearing centre makes
+            its first, largest impacts); NaN (impacts -1) when the run is no longer than
+            the window.
     """
 
     joint: str
@@ -41,6 +48,17 @@ class JointSummary:
     contact_fraction: float
     max_penetration: float
     output_rms_deviation: float
+    startup_window: float = 0.0
+    steady_peak_force: float = float("nan")
+    steady_p95_force: float = float("nan")
+    steady_impacts: int = -1
+    steady_contact_fraction: float = float("nan")
+    steady_max_penetration: float = float("nan")
+
+    @property
+    def has_steady_state(self) -> bool:
+        """Whether the run went on after its start-up window (the steady values exist)."""
+        return self.steady_impacts >= 0
 
 
 def rms_deviation(result: SimulationResult, ideal: SimulationResult, output: str) -> float:
@@ -49,13 +67,16 @@ def rms_deviation(result: SimulationResult, ideal: SimulationResult, output: str
     return float(np.sqrt(np.mean((result.outputs[output] - ref) ** 2)))
 
 
-def joint_summary(result: SimulationResult, joint: str, *, deviation: float = float("nan")) -> JointSummary:
+def joint_summary(
+    result: SimulationResult, joint: str, *, deviation: float = float("nan"), startup: float = 0.0
+) -> JointSummary:
     """Contact statistics of ``joint`` (see `JointSummary`).
 
     Args:
         result: a run.
         joint: name of one of its clearance joints.
         deviation: RMS deviation of the output from ideal, carried into the summary [m or rad].
+        startup: start-up window [s]; > 0 adds the steady-state statistics after it.
 
     Returns:
         The joint's `JointSummary`.
@@ -65,6 +86,17 @@ def joint_summary(result: SimulationResult, joint: str, *, deviation: float = fl
     contact = jr.penetration > 0
     onsets = int(np.count_nonzero(contact[1:] & ~contact[:-1]) + (1 if len(contact) and contact[0] else 0))
     k = int(np.argmax(f)) if len(f) else 0
+    nan = float("nan")
+    s_peak, s_p95, s_impacts, s_fraction, s_pen = nan, nan, -1, nan, nan
+    k0 = int(np.searchsorted(result.times, startup)) if startup > 0 else len(f)
+    if startup > 0 and k0 < len(f) - 1:
+        fs, cs = f[k0:], contact[k0:]
+        before = bool(contact[k0 - 1]) if k0 > 0 else False  # an onset needs the sample before it
+        s_peak = float(fs.max())
+        s_p95 = float(np.percentile(fs[cs], 95)) if cs.any() else 0.0
+        s_impacts = int(np.count_nonzero(cs[1:] & ~cs[:-1]) + (1 if cs[0] and not before else 0))
+        s_fraction = float(cs.mean())
+        s_pen = float(jr.penetration[k0:].max())
     return JointSummary(
         joint=joint,
         peak_force=float(f.max()) if len(f) else 0.0,
@@ -74,14 +106,28 @@ def joint_summary(result: SimulationResult, joint: str, *, deviation: float = fl
         contact_fraction=float(contact.mean()) if len(contact) else 0.0,
         max_penetration=float(jr.penetration.max()) if len(f) else 0.0,
         output_rms_deviation=deviation,
+        startup_window=startup,
+        steady_peak_force=s_peak,
+        steady_p95_force=s_p95,
+        steady_impacts=s_impacts,
+        steady_contact_fraction=s_fraction,
+        steady_max_penetration=s_pen,
     )
 
 
-def summarise(result: SimulationResult, ideal: SimulationResult | None = None) -> list[JointSummary]:
-    """One `JointSummary` per clearance joint; the deviation uses the first output."""
+def summarise(
+    result: SimulationResult, ideal: SimulationResult | None = None, *, startup: float = 0.0
+) -> list[JointSummary]:
+    """One `JointSummary` per clearance joint; the deviation uses the first output.
+
+    Args:
+        result: a run.
+        ideal: its ideal twin's run, for the output deviation (None: NaN).
+        startup: start-up window [s]; > 0 adds each joint's steady-state statistics after it.
+    """
     outputs = [k for k in result.outputs if not k.endswith(("_vel", "_acc"))]
     dev = rms_deviation(result, ideal, outputs[0]) if (ideal is not None and outputs) else float("nan")
-    return [joint_summary(result, j, deviation=dev) for j in result.joints]
+    return [joint_summary(result, j, deviation=dev, startup=startup) for j in result.joints]
 
 
 def write_summary_csv(rows: list[JointSummary], path: str | Path) -> Path:

@@ -39,7 +39,7 @@ def write_outputs(
         # the report's Poincaré sections (t = kT of the drive, after the same transient)
         sections = joint_sections(result, skip=skip)
         print(f"  wrote {record(result, mech, args.rerun, ideal=ideal, poincare=sections)}")
-    rows = summarise(result, ideal)
+    rows = summarise(result, ideal, startup=period or 0.0)
     write_summary_csv(rows, out / "summary.csv")
     write_report(out, result, ideal, skip=skip)
     output = mech.outputs[0].name
@@ -52,10 +52,19 @@ def write_outputs(
             )
             continue
         print(
-            f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
+            f"  {r.joint}, whole run: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
             f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
             f"max penetration {r.max_penetration * 1e6:.3g} µm"
         )
+        window = f"the start-up window (the first drive period, {r.startup_window * 1e3:.3g} ms)"
+        if r.has_steady_state:
+            print(
+                f"  {r.joint}, steady state after {window}: peak force {r.steady_peak_force:.4g} N, "
+                f"p95 {r.steady_p95_force:.4g} N, {r.steady_impacts} impacts, "
+                f"in contact {r.steady_contact_fraction:.1%}, max penetration {r.steady_max_penetration * 1e6:.3g} µm"
+            )
+        elif r.startup_window > 0:
+            print(f"  {r.joint}: no steady state: the run is no longer than its start-up window ({window})")
     if rows:
         unit, scale = ("rad", 1.0) if angular else ("mm", 1e3)
         print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * scale:.4g} {unit}")
