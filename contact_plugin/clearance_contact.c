@@ -560,6 +560,28 @@ static int jb_nstate(const mjModel* m, int instance) {
   return JB_NSTATE;
 }
 
+// the sensordata addresses of a plugin instance's sensors: a malloc'd array (at least one
+// element, so that NULL means out of memory) and their count in *n
+static int* instance_sensors(const mjModel* m, int instance, int* n) {
+  *n = 0;
+  for (int i = 0; i < m->nsensor; i++) {
+    if (m->sensor_type[i] == mjSENS_PLUGIN && m->sensor_plugin[i] == instance) {
+      (*n)++;
+    }
+  }
+  int* adr = (int*)malloc(sizeof(int) * (*n > 0 ? *n : 1));
+  if (!adr) {
+    return NULL;
+  }
+  int k = 0;
+  for (int i = 0; i < m->nsensor; i++) {
+    if (m->sensor_type[i] == mjSENS_PLUGIN && m->sensor_plugin[i] == instance) {
+      adr[k++] = m->sensor_adr[i];
+    }
+  }
+  return adr;
+}
+
 static int jb_nsensordata(const mjModel* m, int instance, int sensor_id) {
   return JB_NSENSOR;
 }
@@ -574,24 +596,11 @@ static int jb_init(const mjModel* m, mjData* d, int instance) {
     free(c);
     return -1;
   }
-  for (int i = 0; i < m->nsensor; i++) {
-    if (m->sensor_type[i] == mjSENS_PLUGIN && m->sensor_plugin[i] == instance) {
-      c->nsensor++;
-    }
-  }
-  if (c->nsensor) {
-    c->sensor_adr = (int*)malloc(sizeof(int) * c->nsensor);
-    if (!c->sensor_adr) {
-      free(c);
-      mju_warning(JB_NAME " instance %d: out of memory", instance);
-      return -1;
-    }
-    int k = 0;
-    for (int i = 0; i < m->nsensor; i++) {
-      if (m->sensor_type[i] == mjSENS_PLUGIN && m->sensor_plugin[i] == instance) {
-        c->sensor_adr[k++] = m->sensor_adr[i];
-      }
-    }
+  c->sensor_adr = instance_sensors(m, instance, &c->nsensor);
+  if (!c->sensor_adr) {
+    free(c);
+    mju_warning(JB_NAME " instance %d: out of memory", instance);
+    return -1;
   }
   d->plugin_data[instance] = (uintptr_t)c;
   return 0;
@@ -774,22 +783,11 @@ static int wm_init(const mjModel* m, mjData* d, int instance) {
   }
   c->nv = nv;
   c->block = (mjtNum*)calloc((size_t)(WM_NWORK + 1) * (nv > 0 ? nv : 1), sizeof(mjtNum));
-  for (int i = 0; i < m->nsensor; i++) {
-    if (m->sensor_type[i] == mjSENS_PLUGIN && m->sensor_plugin[i] == instance) {
-      c->nsensor++;
-    }
-  }
-  c->sensor_adr = (int*)malloc(sizeof(int) * (c->nsensor > 0 ? c->nsensor : 1));
+  c->sensor_adr = instance_sensors(m, instance, &c->nsensor);
   if (!c->block || !c->sensor_adr) {
     wm_free(c);
     mju_warning(WM_NAME " instance %d: out of memory", instance);
     return -1;
-  }
-  int k = 0;
-  for (int i = 0; i < m->nsensor; i++) {
-    if (m->sensor_type[i] == mjSENS_PLUGIN && m->sensor_plugin[i] == instance) {
-      c->sensor_adr[k++] = m->sensor_adr[i];
-    }
   }
   c->qvel = c->block;
   for (int f = 0; f < WM_NWORK; f++) {
