@@ -22,7 +22,6 @@ from clearance.contact_plugin.energy import WORK_FIELDS, WORK_SENSOR, add_energy
 from clearance.model import ContactLaw, Mechanism
 from clearance.options import ModelOptions
 from clearance.results import ENERGY_TERMS, SimulationResult, energy_residual
-from clearance.run.energy import with_energy_meter
 from clearance.run.initial_state import offset_journals
 from clearance.run.preparation import prepare
 from clearance.run.simulation import simulate_prepared
@@ -41,7 +40,7 @@ def _six_bar() -> Mechanism:
 
 
 def _run(mech: Mechanism, h: float, duration: float, mode: str = "exact") -> SimulationResult:
-    prepared = with_energy_meter(prepare(mech, ModelOptions(contact_mode=mode, timestep=h)))
+    prepared = prepare(mech, ModelOptions(contact_mode=mode, timestep=h))  # every prepared run carries the meter
     return simulate_prepared(prepared, duration=duration)
 
 
@@ -206,7 +205,7 @@ def test_chunked_and_thinned_runs_carry_the_same_energy(six_bar_runs):
     """The works live in the plugin state, so chunk boundaries and output thinning change nothing."""
     h = STEPS[0]
     whole = six_bar_runs[h]
-    prepared = with_energy_meter(prepare(_six_bar(), ModelOptions(contact_mode="exact", timestep=h)))
+    prepared = prepare(_six_bar(), ModelOptions(contact_mode="exact", timestep=h))
     chunked = simulate_prepared(prepared, duration=0.02, chunk_steps=777)
     thinned = simulate_prepared(prepared, duration=0.02, output_interval=3 * h, chunk_steps=1000)
     # the states are bitwise those of one rollout; the equality rows' work differs in its last bits

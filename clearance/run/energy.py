@@ -1,7 +1,8 @@
 """Energy series of a run, read from the energy meter's sensor rows (no Python per step).
 
 A model carries the energy meter when `clearance.contact_plugin.energy.add_energy_meter` was
-applied to its spec (`with_energy_meter` does it for a prepared model). Every term is then
+applied to its spec (`clearance.run.preparation.prepare` does it for every run it prepares,
+when the compiled library is installed). Every term is then
 measured on its own, inside ``mujoco.rollout``:
 
 ==========================  =============================================================
@@ -34,16 +35,15 @@ semi-implicit integrators, like their energy error (tests/test_energy.py measure
 
 from __future__ import annotations
 
-import dataclasses
 import warnings
 
 import numpy as np
 
 from clearance.contact_plugin.attributes import sensor_offsets
-from clearance.contact_plugin.energy import add_energy_meter, energy_sensor_addresses, has_energy_meter
+from clearance.contact_plugin.energy import energy_sensor_addresses, has_energy_meter
 from clearance.run.preparation import PreparedModel, exact_contact_name
 
-__all__ = ["read_energy", "with_energy_meter"]
+__all__ = ["read_energy"]
 
 _WORKS = {
     "drive_work": "actuator_work",
@@ -54,29 +54,6 @@ _WORKS = {
     "compiled_contact_work": "plugin_passive_work",
 }
 """Result term -> field of the work sensor (`clearance.contact_plugin.energy.WORK_FIELDS`)."""
-
-
-def with_energy_meter(prepared: PreparedModel) -> PreparedModel:
-    """The same prepared model, compiled with the energy meter (a no-op if it has one).
-
-    The meter is added to a copy of the spec: ``prepared.to_xml()`` still writes the model
-    without it (a ring model stays portable to a MuJoCo without this package's plugin).
-
-    Args:
-        prepared: a prepared model (`clearance.run.preparation.prepare`).
-
-    Returns:
-        A prepared model sharing everything but the compiled model and its sensor slices.
-
-    Raises:
-        clearance.contact_plugin.PluginUnavailableError: if the package was installed without
-            the compiled plugin library.
-    """
-    if has_energy_meter(prepared.model):
-        return prepared
-    spec = prepared.built.spec.copy()
-    add_energy_meter(spec)
-    return dataclasses.replace(prepared, model=spec.compile(), slices=None)
 
 
 def read_energy(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -> dict[str, np.ndarray]:
