@@ -3,8 +3,11 @@
 Sizing is done from the ideal mechanism's joint loads over one drive cycle (inverse
 dynamics): the median load of a clearance joint gives its typical Hertz penetration (for
 the segment-count rule), the peak load an estimate of impact speed and the divergence
-bound. Contact parameters come from `clearance.contact_calibration` (nominal formulas, or
-a fitted calibration) and are written into the pairs' direct-mode solref.
+bound. In the ring modes, contact parameters come from `clearance.contact_calibration`
+(nominal formulas, or a fitted calibration) and are written into the pairs' direct-mode
+solref and solimp; in the exact mode each clearance joint gets an instance of the compiled
+contact plugin. Every run's model carries the energy meter when the compiled library is
+installed (the spec, which `to_xml` writes, does not).
 """
 
 from __future__ import annotations
@@ -57,7 +60,7 @@ class JointSizing:
             calibration is valid for.
         penetration_limit: divergence bound [m]: 4 x the Hertz penetration of an impact at
             ``impact_speed``, at least 4 x that under the peak load.
-        segments: ring segment count N.
+        segments: ring segment count N (0 for the exact contact, which has no ring).
     """
 
     stiffness: float
@@ -170,7 +173,12 @@ def prepare(
                 params[j.name] = _contact_for(j, built, sizing[j.name], options)
         apply_contact(built, model, params)
         contact_meta = {
-            k: {"stiffness_per_row": p.stiffness, "damping_per_row": p.damping, "source": p.source}
+            k: {
+                "stiffness_per_row": p.stiffness,
+                "damping_per_row": p.damping,
+                "impedance_rise": p.impedance_rise,
+                "source": p.source,
+            }
             for k, p in params.items()
         }
     add_initial_keyframe(built, model, initial_controls(mechanism))
