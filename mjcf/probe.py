@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 
 from clearance.mjcf.bearing import RingGeometry
-from clearance.mjcf.spec import _journal_and_bearing
+from clearance.mjcf.bearing_geoms import Placement, add_journal_and_bearing
 from clearance.options import ContactParameters, ModelOptions
 
 __all__ = ["ring_scene", "static_ring_force", "measured_ripple"]
@@ -42,7 +42,8 @@ def ring_scene(
     body.explicitinertial = True
     body.add_joint(name="x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
     body.add_joint(name="y", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0])
-    _journal_and_bearing(spec, body, spec.worldbody, "ring", (0.0, 0.0), (0.0, 0.0), ring, options, friction)
+    centre = Placement((0.0, 0.0, 0.0))
+    add_journal_and_bearing(spec, body, spec.worldbody, "ring", centre, centre, ring, options, friction)
     model = spec.compile()
     a_hat = float(model.body_invweight0[1, 0])
     model.pair_solref[:] = [-params.stiffness * a_hat, -params.damping * a_hat]

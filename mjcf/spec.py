@@ -25,7 +25,14 @@ import mujoco
 import numpy as np
 
 from clearance.kinematics import assemble, velocities
-from clearance.mjcf.bearing import RingGeometry, segment_centres
+from clearance.mjcf.bearing import RingGeometry
+from clearance.mjcf.bearing_geoms import (
+    HALF_THICKNESS,
+    Placement,
+    add_journal_and_bearing,
+    add_journal_and_bearing_visual,
+)
+from clearance.mjcf.bearing_geoms import z_rotation as _quat
 from clearance.mjcf.tree import BodyTree, body_tree
 from clearance.model import DriveKind, Joint, JointType, Link, Mechanism, OutputKind
 from clearance.options import ContactMode, GeomType, ModelOptions
@@ -34,7 +41,7 @@ __all__ = ["BuiltModel", "build_spec", "drive_armature", "drive_gear", "ring_geo
 
 _OBJ = mujoco.mjtObj
 _SENS = mujoco.mjtSensor
-_THICK = 0.004  # half-thickness of visual link geoms and capsule segments along z [m]
+_THICK = HALF_THICKNESS  # half-thickness of visual link geoms along z [m]
 
 
 @dataclass
@@ -87,10 +94,6 @@ def drive_gear(tree: BodyTree, mechanism: Mechanism) -> dict[str, float]:
         child = j.link_b if j.link_b in tree.parent and tree.parent[j.link_b][1] is j else j.link_a
         out[d.name] = 1.0 if child == j.link_b else -1.0
     return out
-
-
-def _quat(theta: float) -> list[float]:
-    return [math.cos(theta / 2), 0.0, 0.0, math.sin(theta / 2)]
 
 
 def _to_frame(pose: np.ndarray, world: np.ndarray) -> np.ndarray:
@@ -235,10 +238,11 @@ def build_spec(
         bp = links[bl].point(j.point_a if bl == j.link_a else j.point_b)
         ring = ring_geometry(j, segments[j.name], options)
         rings[j.name], jbody[j.name], bbody[j.name] = ring, jl, bl
+        jplace, bplace = Placement((jp[0], jp[1], 0.0)), Placement((bp[0], bp[1], 0.0))
         if exact:
-            _journal_and_bearing_visual(bodies[jl], bodies[bl], j.name, jp, bp, ring)
+            add_journal_and_bearing_visual(bodies[jl], bodies[bl], j.name, jplace, bplace, ring)
         else:
-            _journal_and_bearing(spec, bodies[jl], bodies[bl], j.name, jp, bp, ring, options, cl.friction)
+            add_journal_and_bearing(spec, bodies[jl], bodies[bl], j.name, jplace, bplace, ring, options, cl.friction)
         _site(bodies[jl], f"{j.name}__journal", jp)
         _site(bodies[bl], f"{j.name}__bearing", bp)
         _sensor(
@@ -348,101 +352,3 @@ def _visual_link(body: mujoco.MjsBody, link: Link) -> None:
                 fromto=[a[0], a[1], -_THICK, b[0], b[1], -_THICK],
                 **kw,
             )
-
-
-def _geom_type(g: GeomType) -> int:
-    return {
-        GeomType.SPHERE: mujoco.mjtGeom.mjGEOM_SPHERE,
-        GeomType.CAPSULE: mujoco.mjtGeom.mjGEOM_CAPSULE,
-        GeomType.BOX: mujoco.mjtGeom.mjGEOM_BOX,
-        GeomType.CYLINDER: mujoco.mjtGeom.mjGEOM_CYLINDER,
-    }[g]
-
-
-def _journal_and_bearing_visual(
-    jbody: mujoco.MjsBody,
-    bbody: mujoco.MjsBody,
-    name: str,
-    jp: tuple[float, float],
-    bp: tuple[float, float],
-    ring: RingGeometry,
-) -> None:
-    """Journal and bearing drawn for the viewer only (the compiled contact needs no geometry)."""
-    jbody.add_geom(
-        name=f"{name}__journal",
-        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-        size=[ring.journal_radius, _THICK, 0],
-        pos=[jp[0], jp[1], 0],
-        rgba=[0.85, 0.35, 0.2, 1.0],
-        contype=0,
-        conaffinity=0,
-        mass=0,
-    )
-    bbody.add_geom(
-        name=f"{name}__bearing",
-        type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-        size=[ring.bearing_radius, 0.5 * _THICK, 0],
-        pos=[bp[0], bp[1], 0],
-        rgba=[0.3, 0.45, 0.75, 0.35],
-        group=2,
-        contype=0,
-        conaffinity=0,
-        mass=0,
-    )
-
-
-def _journal_and_bearing(
-    spec: mujoco.MjSpec,
-    jbody: mujoco.MjsBody,
-    bbody: mujoco.MjsBody,
-    name: str,
-    jp: tuple[float, float],
-    bp: tuple[float, float],
-    ring: RingGeometry,
-    options: ModelOptions,
-    friction: float,
-) -> None:
-    nocol = dict(contype=0, conaffinity=0)
-    jg = options.journal_geom
-    size = [ring.journal_radius, _THICK, 0] if jg is not GeomType.SPHERE else [ring.journal_radius, 0, 0]
-    jbody.add_geom(
-        name=f"{name}__journal",
-        type=_geom_type(jg),
-        size=size,
-        pos=[jp[0], jp[1], 0],
-        rgba=[0.85, 0.35, 0.2, 1.0],
-        group=0,
-        mass=0,
-        **nocol,
-    )
-    sg = options.segment_geom
-    centres = segment_centres(ring)
-    rs = ring.segment_radius
-    for i, (x, y) in enumerate(centres):
-        phi = math.atan2(y, x)
-        gname = f"{name}__seg{i:03d}"
-        if sg is GeomType.BOX:
-            half_t = ring.bearing_radius * math.tan(math.pi / ring.segments) * 1.05
-            hx = 0.25 * ring.bearing_radius
-            cx = bp[0] + (ring.bearing_radius + hx) * math.cos(phi)
-            cy = bp[1] + (ring.bearing_radius + hx) * math.sin(phi)
-            g = bbody.add_geom(
-                name=gname,
-                type=mujoco.mjtGeom.mjGEOM_BOX,
-                size=[hx, half_t, _THICK],
-                pos=[cx, cy, 0],
-                quat=_quat(phi),
-                **nocol,
-            )
-        else:
-            size = [rs, 0, 0] if sg is GeomType.SPHERE else [rs, _THICK, 0]
-            g = bbody.add_geom(name=gname, type=_geom_type(sg), size=size, pos=[bp[0] + x, bp[1] + y, 0], **nocol)
-        g.rgba = [0.3, 0.45, 0.75, 0.35]
-        g.group = 2
-        g.mass = 0
-        pair = spec.add_pair(name=f"{name}__pair{i:03d}", geomname1=f"{name}__journal", geomname2=gname)
-        pair.condim = 3 if friction > 0 else 1
-        pair.friction = [friction, friction, 0.005, 0.0001, 0.0001]
-        d = options.impedance
-        pair.solimp = [d, d, 0.001, 0.5, 2.0]
-        pair.solref = [-1.0, -0.0]
