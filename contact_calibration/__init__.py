@@ -1,8 +1,10 @@
 """clearance.contact_calibration: contact laws, impact reference, fitting, exact LN, store.
 
 The package re-exports its pure parts, which import no MuJoCo: the contact laws (`laws`)
-and the point-mass impact reference (`impact`). The parts that run MuJoCo are imported from
-their own modules, so ``import clearance.contact_calibration`` stays cheap:
+and the point-mass impact reference (`impact`). The impact reference is imported on first
+use of one of its names (it needs `scipy.integrate`, about 0.3 s to import), so
+``import clearance.contact_calibration`` and its cheap modules (`laws`, `effective_mass`)
+stay cheap. The parts that run MuJoCo are imported from their own modules:
 
   * `store.calibrated_parameters(joint, ring, sizing, options)`: the cached calibration used
     by `ContactMode.CALIBRATED`; `store.calibrate(...)`, `fit.fit_contact(...)`: a full
@@ -15,15 +17,9 @@ their own modules, so ``import clearance.contact_calibration`` stays cheap:
 
 from __future__ import annotations
 
-from clearance.contact_calibration.impact import HertzImpact as HertzImpact
-from clearance.contact_calibration.impact import ImpactResult as ImpactResult
-from clearance.contact_calibration.impact import clearance_impact as clearance_impact
-from clearance.contact_calibration.impact import hertz_impact as hertz_impact
-from clearance.contact_calibration.impact import law_impact as law_impact
-from clearance.contact_calibration.impact import simulate_impact as simulate_impact
-from clearance.contact_calibration.impact import (
-    simulate_oblique_impact as simulate_oblique_impact,
-)
+import importlib
+from typing import TYPE_CHECKING
+
 from clearance.contact_calibration.laws import MIN_APPROACH_SPEED as MIN_APPROACH_SPEED
 from clearance.contact_calibration.laws import STIFFNESS_FORMULA as STIFFNESS_FORMULA
 from clearance.contact_calibration.laws import (
@@ -45,3 +41,36 @@ from clearance.contact_calibration.laws import (
     lankarani_nikravesh as lankarani_nikravesh,
 )
 from clearance.contact_calibration.laws import normal_force as normal_force
+
+if TYPE_CHECKING:
+    from clearance.contact_calibration.impact import HertzImpact as HertzImpact
+    from clearance.contact_calibration.impact import ImpactResult as ImpactResult
+    from clearance.contact_calibration.impact import clearance_impact as clearance_impact
+    from clearance.contact_calibration.impact import hertz_impact as hertz_impact
+    from clearance.contact_calibration.impact import law_impact as law_impact
+    from clearance.contact_calibration.impact import simulate_impact as simulate_impact
+    from clearance.contact_calibration.impact import (
+        simulate_oblique_impact as simulate_oblique_impact,
+    )
+
+_FROM_IMPACT = frozenset(
+    {
+        "HertzImpact",
+        "ImpactResult",
+        "clearance_impact",
+        "hertz_impact",
+        "law_impact",
+        "simulate_impact",
+        "simulate_oblique_impact",
+    }
+)
+"""Names re-exported from `impact`, imported on first use."""
+
+
+def __getattr__(name: str) -> object:
+    """A re-exported name of the impact reference, importing `impact` on first use."""
+    if name not in _FROM_IMPACT:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    value = getattr(importlib.import_module(f"{__name__}.impact"), name)
+    globals()[name] = value
+    return value

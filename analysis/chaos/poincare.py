@@ -16,7 +16,8 @@ this criterion (`classify_poincare`):
    strange attractor nearby points separate, and the median is of the order of the largest
    Lyapunov exponent times T. A median above ``divergence_threshold`` means CHAOTIC,
    otherwise QUASI_PERIODIC.
-3. Fewer than ``min_points`` non-periodic points, or a single point, give UNDETERMINED.
+3. Fewer than ``min_points`` (`MIN_SECTION_POINTS`, 20) non-periodic points, or a single
+   point, give UNDETERMINED; `section_warning` words the caution for figures and reports.
 
 The Grassberger-Procaccia correlation dimension is reported beside the regime (about 1
 for a closed curve, above 1 for the section of a strange attractor) as a diagnostic.
@@ -28,12 +29,11 @@ import enum
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
-from scipy.spatial.distance import pdist
 
 from clearance.results import SimulationResult
 
 __all__ = [
+    "MIN_SECTION_POINTS",
     "PhasePortrait",
     "PoincareClassification",
     "Regime",
@@ -47,7 +47,12 @@ __all__ = [
     "quantity_series",
     "run_section",
     "RunSection",
+    "section_warning",
 ]
+
+MIN_SECTION_POINTS = 20
+"""Fewest section points from which a regime is told (`classify_poincare`'s ``min_points``):
+fewer say too little about recurrence or divergence, and figures and reports say so."""
 
 _JOINT_PARTS = {
     "ex": ("eccentricity", 0),
@@ -290,6 +295,8 @@ def correlation_dimension(points: np.ndarray, *, r_quantiles: tuple[float, float
     p = np.asarray(points, dtype=float).reshape(len(points), -1)
     if len(p) < 10:
         return float("nan")
+    from scipy.spatial.distance import pdist  # here: a short run's section (< 10 points) never imports scipy.spatial
+
     d = np.sort(pdist(p))
     d = d[d > 0]
     if len(d) < 10:
@@ -315,6 +322,8 @@ def map_divergence(points: np.ndarray) -> float:
     p = np.asarray(points, dtype=float).reshape(len(points), -1)
     if len(p) < 3:
         return float("nan")
+    from scipy.spatial import cKDTree  # here: a short run's section (< 3 points) never imports scipy.spatial
+
     head = p[:-1]
     tree = cKDTree(head)
     dist, idx = tree.query(head, k=min(3, len(head)))
@@ -347,7 +356,7 @@ def classify_poincare(
     atol: float = 0.0,
     max_period: int = 16,
     divergence_threshold: float = 0.2,
-    min_points: int = 20,
+    min_points: int = MIN_SECTION_POINTS,
 ) -> PoincareClassification:
     """Classify a Poincaré point set as periodic, quasi-periodic or chaotic.
 
@@ -423,3 +432,21 @@ def largest_lyapunov(
     else:
         sel = (t >= fit[0]) & (t <= fit[1])
     return float(np.polyfit(t[sel], np.log(np.maximum(sep[sel], floor)), 1)[0])
+
+
+def section_warning(n_points: int, *, min_points: int = MIN_SECTION_POINTS) -> str | None:
+    """The caution for a Poincaré section with too few points, or None when it has enough.
+
+    Args:
+        n_points: section points (one per drive period after the start-up window).
+        min_points: the threshold (`MIN_SECTION_POINTS`).
+
+    Returns:
+        A sentence naming the count, the threshold and the run length that reaches it.
+    """
+    if n_points >= min_points:
+        return None
+    return (
+        f"only {n_points} section point{'s' if n_points != 1 else ''} (fewer than {min_points}): too few drive "
+        f"periods to tell the regime; a run of {min_points + 1} drive periods or more gives {min_points}"
+    )

@@ -13,7 +13,6 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import stats
 
 from clearance.model import Mechanism
 from clearance.results import SimulationResult
@@ -62,6 +61,8 @@ def linear_fit(x: Sequence[float], y: Sequence[float]) -> LinearFit:
         raise ValueError(f"linear_fit needs at least 3 (x, y) pairs of equal length (got {len(xa)}, {len(ya)})")
     if np.ptp(xa) == 0:
         raise ValueError("linear_fit needs at least two different x values")
+    from scipy import stats  # here, not at import: scipy.stats takes about 0.4 s to import
+
     r = stats.linregress(xa, ya)
     return LinearFit(float(r.slope), float(r.intercept), float(r.rvalue**2), len(xa))
 
@@ -99,6 +100,8 @@ def trend(x: Sequence[float], y: Sequence[float]) -> Trend:
     order = np.argsort(xa, kind="stable")
     ys = ya[order]
     if len(xa) >= 3:
+        from scipy import stats  # here, not at import: scipy.stats takes about 0.4 s to import
+
         rho, p = stats.spearmanr(xa, ya)
     else:
         rho, p = float(np.sign(ys[-1] - ys[0])), float("nan")
@@ -141,6 +144,8 @@ def rank_agreement(first: Sequence[str], second: Sequence[str]) -> RankAgreement
     in_second = [k for k in second if k in set(common)]
     ra = np.arange(len(common))
     rb = np.array([in_second.index(k) for k in common])
+    from scipy import stats  # here, not at import: scipy.stats takes about 0.4 s to import
+
     tau, p = stats.kendalltau(ra, rb)
     return RankAgreement(float(tau), float(p), tuple(common), common == in_second, common[0] == in_second[0])
 

@@ -1,10 +1,10 @@
 """Deviation statistics of an output against the ideal mechanism's output.
 
 The measures of the clearance-criticality literature (REFERENCES.md section 5): mean
-deviation, RMS deviation, 90 % tolerance band, and three two-sample tests from
-`scipy.stats` (t-test on the deviation, F-test on the variances, Kolmogorov-Smirnov on the
-distributions). All are taken over a steady-state window that skips the start-up
-transient (by default the first drive period).
+deviation, RMS deviation, 90 % tolerance band, and three two-sample tests (t-test on the
+deviation, F-test on the variances, Kolmogorov-Smirnov on the distributions: the results of
+`scipy.stats`, computed by `clearance.analysis.metrics.significance`). All are taken over a
+steady-state window that skips the start-up transient (by default the first drive period).
 
 The samples of a simulated output are strongly autocorrelated, so the tests' p-values are
 not probabilities of independent samples; use the statistics to compare runs with each
@@ -16,8 +16,8 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy import stats
 
+from clearance.analysis.metrics.significance import ks_two_sample, paired_t_test, variance_ratio_cdf
 from clearance.results import SimulationResult
 
 __all__ = [
@@ -50,7 +50,8 @@ class DeviationStatistics:
         f_statistic, f_pvalue: F = var(y) / var(y_ideal) with (n - 1, n - 1) degrees of
             freedom, two-sided p-value.
         ks_statistic, ks_pvalue: two-sample Kolmogorov-Smirnov test of y against y_ideal
-            (`scipy.stats.ks_2samp`).
+            (`scipy.stats.ks_2samp`; its p-value exact at every n, where scipy's is asymptotic
+            above n = 10,000).
     """
 
     n: int
@@ -161,16 +162,15 @@ def deviation_statistics_from_arrays(
     if np.ptp(d) <= 1e-12 * max(float(np.max(np.abs(d))), np.finfo(float).tiny):
         t_stat, t_p = (0.0, 1.0) if d[0] == 0 else (float(np.sign(d[0]) * np.inf), 0.0)
     else:
-        tt = stats.ttest_rel(y, y_ideal)
-        t_stat, t_p = float(tt.statistic), float(tt.pvalue)
+        t_stat, t_p = paired_t_test(y, y_ideal)
     v1, v0 = np.var(y, ddof=1), np.var(y_ideal, ddof=1)
     if v0 > 0:
         f_stat = float(v1 / v0)
-        cdf = stats.f.cdf(f_stat, n - 1, n - 1)
+        cdf = variance_ratio_cdf(f_stat, n - 1, n - 1)
         f_p = float(min(1.0, 2 * min(cdf, 1 - cdf)))
     else:
         f_stat, f_p = (float("nan"), float("nan"))
-    ks = stats.ks_2samp(y, y_ideal)
+    ks_stat, ks_p = ks_two_sample(y, y_ideal)
     lo, hi = np.percentile(d, [5, 95])
     return DeviationStatistics(
         n=n,
@@ -187,8 +187,8 @@ def deviation_statistics_from_arrays(
         t_pvalue=t_p,
         f_statistic=f_stat,
         f_pvalue=f_p,
-        ks_statistic=float(ks.statistic),
-        ks_pvalue=float(ks.pvalue),
+        ks_statistic=ks_stat,
+        ks_pvalue=ks_p,
     )
 
 

@@ -26,7 +26,6 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
-from scipy import stats
 
 from clearance.analysis.sweeps.sweep import MechanismFactory, SweepEvaluation, run_sweep
 from clearance.model import Mechanism, OutputKind
@@ -228,6 +227,8 @@ def rank_joints(
     for key in sorted({(c, s) for _, c, s, *_ in raw}):
         group = sorted((x for x in raw if (x[1], x[2]) == key), key=lambda x: -x[3])
         cells += [CellDeviation(*x, rank=i + 1) for i, x in enumerate(group)]
+    from scipy import stats  # here, not at import: scipy.stats takes about 0.4 s to import
+
     joints = list(dict.fromkeys(c.joint for c in cells))
     tmp = []
     for j in joints:

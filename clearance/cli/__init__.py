@@ -3,6 +3,7 @@
     clearance run        simulate a scenario and write arrays, summary, figures, MJCF
     clearance reference  run a scenario with the exact-geometry reference solver
     clearance mjcf       write the MuJoCo model of a scenario
+    clearance view       MuJoCo's viewer on a model or a run's folder, at its initial state
     clearance calibrate  fit contact parameters to LN impacts and write a report
     clearance sweep      bifurcation diagram over clearance or drive speed (resumable)
     clearance rank       joint criticality ranking (resumable)
@@ -44,7 +45,7 @@ _OWN_PARSER = {
 }
 """Commands with a parser of their own: name -> (module, entry point, help)."""
 
-_SUBPARSERS = ("clearance.cli.run", "clearance.cli.reference", "clearance.cli.mjcf")
+_SUBPARSERS = ("clearance.cli.run", "clearance.cli.reference", "clearance.cli.mjcf", "clearance.cli.view")
 """Modules whose command is parsed here; each has ``add_parser(sub)`` and ``command(args)``."""
 
 
