@@ -13,6 +13,15 @@ Energy balance. A run may carry its energy terms as time series (`SimulationResu
 (Δ: change since the first row; works: done ON the mechanism since the first row, so a damper's
 or a contact's work is negative; dissipated_work >= 0 is the energy a compiled contact turned
 into heat). A conservative run has residual 0 up to the integrator's error.
+
+Joint reactions. `SimulationResult.joint_reactions` holds, per joint (ideal, clearance and
+prismatic alike), the force the joint's first-named link (``Joint.link_a``) exerts on its second
+(``link_b``) through the joint, (n, 2) in the world frame [N]; ``link_a`` receives the opposite. A
+clearance joint's reaction is its contact force: ``R(theta_bearing) @ contact_force`` when the
+journal is ``link_b``, minus that when the journal is ``link_a`` (``contact_force`` is the force
+on the journal in the bearing frame). A prismatic pair's reaction is the force it transmits
+(normal to the guide, plus any friction along it); the moment it carries is not included. The
+drives' torques are `SimulationResult.drive_torque`.
 """
 
 from __future__ import annotations
@@ -226,6 +235,9 @@ class SimulationResult:
             summary (``energy_balance``, see `energy_balance`) (JSON-serialisable).
         energy: name -> (n,) energy series [J] (`ENERGY_TERMS`); empty when the run did not
             measure them (a model without the energy meter, a result saved before they existed).
+        joint_reactions: joint name -> (n, 2) force that the joint's link_a exerts on its link_b,
+            world frame [N] (module docstring); every joint of the mechanism, in its order; empty
+            in results saved before reactions existed.
     """
 
     times: np.ndarray
@@ -238,6 +250,7 @@ class SimulationResult:
     closure_violation: np.ndarray
     metadata: dict[str, Any] = field(default_factory=dict)
     energy: dict[str, np.ndarray] = field(default_factory=dict)
+    joint_reactions: dict[str, np.ndarray] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return len(self.times)
@@ -269,6 +282,7 @@ class SimulationResult:
             closure_violation=self.closure_violation[sl],
             metadata=self.metadata,
             energy={k: v[sl] for k, v in self.energy.items()},
+            joint_reactions={k: v[sl] for k, v in self.joint_reactions.items()},
         )
 
     def decimated(self, every: int) -> SimulationResult:
@@ -298,6 +312,7 @@ class SimulationResult:
             closure_violation=cat([p.closure_violation for p in parts]),
             metadata=first.metadata,
             energy={k: cat([p.energy[k] for p in parts]) for k in first.energy},
+            joint_reactions={k: cat([p.joint_reactions[k] for p in parts]) for k in first.joint_reactions},
         )
 
     # -- persistence --------------------------------------------------------------------
@@ -329,6 +344,8 @@ class SimulationResult:
                 arrays[f"joint/{j}/{f}"] = getattr(jr, f)
         for k, v in self.energy.items():
             arrays[f"energy/{k}"] = v
+        for k, v in self.joint_reactions.items():
+            arrays[f"reaction/{k}"] = v
         buf = io.BytesIO()
         # numpy's stubs type **kwds against the allow_pickle keyword (absent before numpy 2.1) too
         np.savez_compressed(buf, **arrays)  # type: ignore[arg-type]
@@ -340,6 +357,7 @@ class SimulationResult:
             # the summary always describes the arrays saved beside it
             meta["energy_balance"] = self.energy_balance()
             meta["energy_names"] = list(self.energy)
+        meta["reaction_names"] = list(self.joint_reactions)
         atomic_write_bytes(npz, buf.getvalue())
         atomic_write_text(js, json.dumps(meta, indent=2, sort_keys=True, default=_json_default))
         return npz, js
@@ -352,6 +370,7 @@ class SimulationResult:
         out_names = meta.pop("output_names")
         joint_names = meta.pop("joint_names")
         energy_names = meta.pop("energy_names", [])  # absent in files saved before energy series existed
+        reaction_names = meta.pop("reaction_names", [])  # absent in files saved before reactions existed
         with np.load(stem.with_suffix(".npz"), allow_pickle=False) as z:
             return cls(
                 times=z["times"],
@@ -364,6 +383,7 @@ class SimulationResult:
                 closure_violation=z["closure_violation"],
                 metadata=meta,
                 energy={k: z[f"energy/{k}"] for k in energy_names},
+                joint_reactions={k: z[f"reaction/{k}"] for k in reaction_names},
             )
 
 

@@ -13,7 +13,11 @@ Sensor names (read by `clearance.simulate`):
   velocities of journal and bearing centres, bearing angular velocity and x axis;
   ``<joint>__force``: net contact force between bearing and journal bodies (world);
   ``<output>__pos``, ``__vel``, ``__acc`` (point outputs) or ``__angvel``, ``__angacc``;
-  ``<drive>__angle``, ``__speed``, ``__torque``; ``<cut>__closure`` for ideal cuts.
+  ``<drive>__angle``, ``__speed``, ``__torque``; ``<cut>__closure`` for ideal cuts;
+  ``<joint>__reaction``: for every tree joint, the force its parent body exerts on the child
+  body's subtree (MuJoCo's ``cfrc_int``), in the frame of a site at the child's anchor whose axes
+  are the child body's; ``<link>__comacc``: centre-of-mass acceleration minus gravity (world) of
+  each link that an ideal cut touches (`clearance.run.reactions` reads both).
 """
 
 from __future__ import annotations
@@ -271,6 +275,8 @@ def build_spec(
         )
         s.intprm[:3] = [2, 3, 1]  # data = force, reduce = netforce, num = 1
 
+    _reaction_sensors(spec, bodies, tree, links, mechanism.ground)
+
     for n in names:
         # xbody: the body (link) frame; "body" would be the inertial frame at the centre of mass
         _sensor(spec, f"{n}__pos", _SENS.mjSENS_FRAMEPOS, _OBJ.mjOBJ_XBODY, n)
@@ -303,6 +309,31 @@ def build_spec(
         _sensor(spec, f"{d.name}__torque", _SENS.mjSENS_ACTUATORFRC, _OBJ.mjOBJ_ACTUATOR, d.name)
 
     return BuiltModel(spec, tree, rings, jbody, bbody, gears, q0, qd0, tuple(names), exact)
+
+
+def _reaction_sensors(
+    spec: mujoco.MjSpec,
+    bodies: dict[str, mujoco.MjsBody],
+    tree: BodyTree,
+    links: dict[str, Link],
+    ground: str,
+) -> None:
+    """Sensors from which a run reads every joint's reaction (see the module docstring).
+
+    A FORCE sensor per tree joint reads the force through it; a body that an ideal cut touches
+    also gets its centre-of-mass acceleration, so that the cut's force follows from the body's
+    Newton equation. Both need MuJoCo's post-constraint pass, which the output acceleration
+    sensors already request, so they add little to a step.
+    """
+    for child in tree.order:
+        _, joint = tree.parent[child]
+        anchor = links[child].point(joint.point_b if joint.link_b == child else joint.point_a)
+        _site(bodies[child], f"{joint.name}__anchor", anchor)
+        _sensor(spec, f"{joint.name}__reaction", _SENS.mjSENS_FORCE, _OBJ.mjOBJ_SITE, f"{joint.name}__anchor")
+    touched = sorted({lk for j in tree.ideal_cuts for lk in (j.link_a, j.link_b) if lk != ground})
+    for n in touched:
+        # objtype BODY: the inertial frame, at the centre of mass
+        _sensor(spec, f"{n}__comacc", _SENS.mjSENS_FRAMELINACC, _OBJ.mjOBJ_BODY, n)
 
 
 def _drive_gain(mechanism: Mechanism, options: ModelOptions) -> float:

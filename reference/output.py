@@ -10,7 +10,12 @@ that sample) for accelerations, contact forces and drive torques. Frames and sig
     drive_torque: torque the drive applies to link_b (positive work at positive speed);
   * closure_violation: largest ideal-joint closure error [m] (revolute: norm of the
     position mismatch; prismatic: distance from the guide line);
-  * link_poses: link-frame poses (x, y, theta) of the moving links.
+  * link_poses: link-frame poses (x, y, theta) of the moving links;
+  * joint_reactions: per joint, the force its link_a exerts on its link_b, world frame: for an
+    ideal joint from the Lagrange multipliers of its two rows (M zdd + G' lambda = Q, so a
+    revolute row pair p_a - p_b = 0 gives link_b the force +lambda; a prismatic pair's distance
+    row n . (p_b - p_a) = 0 gives link_b -lambda_2 n, n the guide's normal), for a clearance joint
+    its contact force (on the journal, signed by which side the journal is).
 """
 
 from __future__ import annotations
@@ -43,9 +48,11 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
     cres = np.zeros((n, nc, 13))
     torque = np.empty((n, nd))
     closure = np.empty(n)
+    lam = np.zeros((n, system.n_constraints))
     for i in range(n):
         ev = system.evaluate(float(traj.times[i]), traj.z[i].tolist(), traj.zd[i].tolist(), traj.vin[i].tolist())
         zdd[i] = ev.zdd
+        lam[i] = ev.lam
         if nc:
             cres[i] = ev.contacts
         torque[i] = ev.drive_torque
@@ -70,6 +77,7 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
         pen = np.hypot(e[:, 0], e[:, 1]) - cj.c
         joints[cj.name] = JointResult(e, erate, pen, force)
 
+    reactions = _reactions(system, q, lam, cres)
     angle, speed = np.empty((n, nd)), np.empty((n, nd))
     for k, d in enumerate(system.drives):
         tb = q[:, 3 * d.ib + 2] if d.ib >= 0 else 0.0
@@ -109,4 +117,31 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
         closure_violation=closure,
         metadata=meta,
         energy=energy,
+        joint_reactions=reactions,
     )
+
+
+def _reactions(system: ReferenceSystem, q: np.ndarray, lam: np.ndarray, cres: np.ndarray) -> dict[str, np.ndarray]:
+    """Joint name -> (n, 2) force its link_a exerts on its link_b, world [N] (module docstring).
+
+    Args:
+        system: the system.
+        q: (n, nq) link-frame coordinates.
+        lam: (n, n_constraints) multipliers.
+        cres: (n, n_contacts, 13) contact evaluations (force on the journal at 7, 8).
+    """
+    out: dict[str, np.ndarray] = {}
+    for k, (name, pair) in enumerate(zip(system.rows.pair_names, system.rows.pairs)):
+        rev, ia = pair[0], pair[1]
+        if rev:
+            out[name] = lam[:, 2 * k : 2 * k + 2].copy()
+            continue
+        ux, uy = pair[7], pair[8]
+        th = q[:, 3 * ia + 2] if ia >= 0 else np.zeros(len(q))
+        c, s = np.cos(th), np.sin(th)
+        normal = np.stack([c * ux - s * uy, s * ux + c * uy], axis=1)
+        out[name] = -lam[:, 2 * k + 1 : 2 * k + 2] * normal
+    for k, cj in enumerate(system.contacts):
+        on_journal = cres[:, k, 7:9]
+        out[cj.name] = -on_journal if system.joint_links[cj.name][0] == cj.journal_link else on_journal.copy()
+    return {name: out[name] for name in system.joint_links if name in out}

@@ -185,6 +185,8 @@ class ReferenceSystem:
         self.alpha, self.beta, self.min_approach_speed = alpha, beta, vmin
         self.options = o
         self.ground = ground
+        self.joint_links = {j.name: (j.link_a, j.link_b) for j in joints}
+        """joint name -> (link_a, link_b), in the joints' order."""
         self.links = tuple(lk for lk in links if lk.name != ground)
         self.link_names = [lk.name for lk in self.links]
         index = {n: i for i, n in enumerate(self.link_names)}

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import mujoco
 import numpy as np
@@ -35,6 +35,9 @@ from clearance.mjcf import (
 )
 from clearance.model import DriveKind, Joint, Mechanism
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
+
+if TYPE_CHECKING:
+    from clearance.run.reactions import ReactionLayout
 
 __all__ = ["JointSizing", "PreparedModel", "prepare", "initial_controls", "exact_contact_name", "TimeStepError"]
 
@@ -76,7 +79,11 @@ class JointSizing:
 
 @dataclass
 class PreparedModel:
-    """A compiled model and everything `simulate` needs to run and read it."""
+    """A compiled model and everything `simulate` needs to run and read it.
+
+    ``slices`` (sensor name -> slice of a sensor row) and ``reactions`` (the joint reactions'
+    readout layout) are filled by the first readout of the model.
+    """
 
     mechanism: Mechanism
     options: ModelOptions
@@ -86,6 +93,7 @@ class PreparedModel:
     contact: dict[str, ContactParameters]
     metadata: dict[str, Any] = field(default_factory=dict)
     slices: dict[str, slice] | None = None
+    reactions: ReactionLayout | None = None
 
     def to_xml(self) -> str:
         """MJCF text of the model (with contact parameters and the initial keyframe)."""

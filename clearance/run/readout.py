@@ -1,8 +1,16 @@
 """Turn a chunk of MuJoCo sensor rows into a `SimulationResult` (vectorised, no per-step Python).
 
 Sensor names are those written by `clearance.mjcf.spec`. With `mujoco.rollout`, sensor
-row i describes the state at t_i = i h (before step i is integrated). A model with the energy
-meter also gets its energy series (`clearance.run.energy`).
+row i describes the state at t_i = i h (before step i is integrated) and state row i the state
+after it, at t_i + h. A model with the energy meter also gets its energy series
+(`clearance.run.energy`); every run gets its joint reactions (`clearance.run.reactions`).
+
+Drive torque. A speed drive is a velocity actuator that implicitfast integrates implicitly:
+over step i it applies F(v_i) + dF/dv (v_{i+1} - v_i), the force at the step's end velocity,
+not the force F(v_i) its sensor reads at the step's start (with the drive's large gain they
+differ by up to a hundred N m at an impact). Row i's drive torque is that applied force less the
+armature's share, armature * (v_{i+1} - v_i) / h: the torque the drive passed to the mechanism
+over step i, which state row i's velocity gives exactly.
 """
 
 from __future__ import annotations
@@ -15,6 +23,7 @@ from clearance.model import OutputKind
 from clearance.results import JointResult, SimulationResult
 from clearance.run.energy import read_energy
 from clearance.run.preparation import PreparedModel, exact_contact_name
+from clearance.run.reactions import reaction_layout, read_reactions, rotate
 
 __all__ = ["read_sensors", "sensor_slices"]
 
@@ -46,11 +55,22 @@ def _angle(xaxis: np.ndarray) -> np.ndarray:
     return np.unwrap(np.arctan2(xaxis[:, 1], xaxis[:, 0]))
 
 
-def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -> SimulationResult:
+def read_sensors(
+    prepared: PreparedModel, times: np.ndarray, sens: np.ndarray, states: np.ndarray | None = None
+) -> SimulationResult:
     """Build a result from sensor rows of shape (n, nsensordata) at ``times`` (n,) [s].
 
     ``times`` are multiples of the time step counted from the run's start (row i of the run at
     step i): the energy meter's step count is checked against them.
+
+    Args:
+        prepared: the model.
+        times: (n,) [s].
+        sens: (n, nsensordata) sensor rows, row i at the state before step i.
+        states: (n, nstate) full-physics state rows of the same rollout, row i after step i:
+            they give the drives' end-of-step velocities (module docstring). Without them the
+            next sensor row stands in, and the last row keeps the step-start force with no
+            armature correction.
     """
     mech, model = prepared.mechanism, prepared.model
     if prepared.slices is None:
@@ -83,6 +103,7 @@ def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -
             outputs[o.name + "_acc"] += model.opt.gravity[comp]
 
     joints: dict[str, JointResult] = {}
+    journal_world: dict[str, np.ndarray] = {}
     for jname, ring in prepared.built.rings.items():
         e = get(f"{jname}__ecc")[:, :2].copy()
         bx = get(f"{jname}__bxaxis")
@@ -95,11 +116,23 @@ def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -
         )
         if prepared.built.exact_contact:
             force = _exact_contact_force(sens, sensor_offsets(model, exact_contact_name(jname)), e)
+            journal_world[jname] = rotate(bx, force)
         else:
             fw = get(f"{jname}__force")[:, :2]
             force = np.stack([c * fw[:, 0] + s * fw[:, 1], -s * fw[:, 0] + c * fw[:, 1]], axis=1)
+            journal_world[jname] = fw.copy()
         pen = np.hypot(e[:, 0], e[:, 1]) - ring.radial_clearance
         joints[jname] = JointResult(e, erate, pen, force)
+
+    if prepared.reactions is None:
+        tree = prepared.built.tree
+        prepared.reactions = reaction_layout(
+            mech,
+            {child: (par, j.name) for child, (par, j) in tree.parent.items()},
+            tuple(j.name for j in tree.ideal_cuts),
+            exact_contact=prepared.built.exact_contact,
+        )
+    reactions = read_reactions(prepared.reactions, get, journal_world, n)
 
     nd = len(mech.drives)
     angle, speed, torque = np.empty((n, nd)), np.empty((n, nd)), np.empty((n, nd))
@@ -107,11 +140,7 @@ def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -
         g = prepared.built.drive_gear[d.name]
         angle[:, k] = d.start_angle + g * get(f"{d.name}__angle")[:, 0]
         speed[:, k] = g * get(f"{d.name}__speed")[:, 0]
-        torque[:, k] = get(f"{d.name}__torque")[:, 0]
-        arm = float(model.dof_armature[model.jnt_dofadr[model.joint(d.joint).id]])
-        if arm and n > 1:
-            # torque passed to the mechanism = actuator torque - armature inertial torque
-            torque[:, k] -= arm * np.gradient(speed[:, k], times)
+        torque[:, k] = _drive_torque(prepared, d.joint, d.name, get(f"{d.name}__torque")[:, 0], speed[:, k], g, states)
 
     cuts = prepared.built.tree.ideal_cuts
     if cuts:
@@ -119,4 +148,48 @@ def read_sensors(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) -
     else:
         closure = np.zeros(n)
     energy = read_energy(prepared, times, sens)
-    return SimulationResult(times, outputs, joints, angle, speed, torque, poses, closure, {}, energy)
+    return SimulationResult(times, outputs, joints, angle, speed, torque, poses, closure, {}, energy, reactions)
+
+
+def _drive_torque(
+    prepared: PreparedModel,
+    joint: str,
+    actuator: str,
+    force: np.ndarray,
+    speed: np.ndarray,
+    gear: float,
+    states: np.ndarray | None,
+) -> np.ndarray:
+    """(n,) torque a drive passed to the mechanism over each step [N m] (module docstring).
+
+    Args:
+        prepared: the model.
+        joint, actuator: the driven joint and the drive's actuator.
+        force: (n,) actuator force at each step's start (its sensor) [N m].
+        speed: (n,) drive speed at each step's start, gear * qvel [rad/s].
+        gear: +1 or -1 (drive angle = start + gear * qpos).
+        states: (n, nstate) state rows after each step, or None.
+    """
+    model = prepared.model
+    dof = int(model.jnt_dofadr[model.joint(joint).id])
+    n = len(force)
+    if states is not None:
+        at = mujoco.mj_stateSize(model, mujoco.mjtState.mjSTATE_TIME | mujoco.mjtState.mjSTATE_QPOS) + dof
+        end = gear * states[:n, at]
+        full = n
+    else:
+        end = np.append(speed[1:], speed[-1:])
+        full = n - 1
+    dv = np.zeros(n)
+    dv[:full] = (end - speed)[:full]  # change of gear * qvel over each step
+    act = model.actuator(actuator).id
+    implicit = model.opt.integrator in (mujoco.mjtIntegrator.mjINT_IMPLICIT, mujoco.mjtIntegrator.mjINT_IMPLICITFAST)
+    dfdv = 0.0
+    if implicit and model.actuator_biastype[act] == mujoco.mjtBias.mjBIAS_AFFINE:
+        # the actuator force's velocity derivative that implicit integration applies (the drives'
+        # gains are fixed, so the bias alone carries it); actuator velocity = gear * qvel
+        dfdv = float(model.actuator_biasprm[act, 2])
+    arm = float(model.dof_armature[dof])
+    h = model.opt.timestep
+    # torque passed to the mechanism = force applied over the step - armature inertial torque
+    return force + dfdv * dv - arm * dv / h

@@ -168,7 +168,7 @@ def simulate_prepared(
             states, sens, data = step(ctrl, n)
         except _StepFailure as fail:
             states, sens, data, failure = fail.states, fail.sens, fail.data, fail.reason
-        part = read_sensors(prepared, times[: len(sens)], sens)
+        part = read_sensors(prepared, times[: len(sens)], sens, states[: len(sens)])
         # a stepper that stopped early has placed its warning at the step: only rows before it came back
         bad = _first_bad(prepared, data, part, states, sens, warnings=failure is None)
         if failure is not None and (bad is None or bad[0] >= len(sens)):
