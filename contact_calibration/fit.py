@@ -39,12 +39,11 @@ import math
 import time
 from collections.abc import Sequence
 from dataclasses import asdict, dataclass, field
+from typing import TYPE_CHECKING
 
 import mujoco
 import numpy as np
-from scipy.optimize import least_squares
 
-from clearance.contact_calibration.impact import ImpactResult, law_impact
 from clearance.contact_calibration.laws import bearing_stiffness
 from clearance.contact_calibration.nominal import nominal_parameters
 from clearance.contact_calibration.scene_impact import (
@@ -56,6 +55,9 @@ from clearance.contact_calibration.scene_impact import (
 from clearance.mjcf.bearing import RingGeometry, ring_damping_coefficient, ring_force
 from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters, ModelOptions
+
+if TYPE_CHECKING:
+    from clearance.contact_calibration.impact import ImpactResult
 
 __all__ = [
     "GOALS",
@@ -235,6 +237,10 @@ def reference_impacts(clearance: Clearance, *, mass: float, speeds: np.ndarray) 
     Raises:
         ValueError: for the IMPACT law (it needs c_max and d_max, not a restitution).
     """
+    # here, not at import: the impact reference needs scipy.integrate (0.3 s to import), and a
+    # run whose calibration is cached reads this module without fitting
+    from clearance.contact_calibration.impact import law_impact
+
     if clearance.law is ContactLaw.IMPACT:
         raise ValueError("calibration against the IMPACT law is not supported (no c_max/d_max in Clearance)")
     k = bearing_stiffness(clearance)
@@ -438,6 +444,8 @@ def fit_contact(
         CalibrationStabilityError: the fitted parameters are unstable at the time step.
         ValueError: bad arguments (mass, speeds) or an unsupported law.
     """
+    from scipy.optimize import least_squares  # here, not at import (see reference_impacts)
+
     t0 = time.perf_counter()
     if not (math.isfinite(mass) and mass > 0):
         raise ValueError(f"mass must be positive and finite (got {mass!r} kg)")

@@ -15,12 +15,11 @@ drifts with impact speed; `clearance.contact_calibration` fits better values.
 from __future__ import annotations
 
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 from numpy.typing import ArrayLike
-from scipy.optimize import brentq
 
-from clearance.contact_calibration.impact import ForceLaw, ImpactResult, law_impact, simulate_impact
 from clearance.contact_calibration.laws import bearing_stiffness
 from clearance.mjcf.bearing import (
     RingGeometry,
@@ -29,6 +28,9 @@ from clearance.mjcf.bearing import (
 )
 from clearance.model import Clearance, ContactLaw
 from clearance.options import ContactParameters
+
+if TYPE_CHECKING:
+    from clearance.contact_calibration.impact import ForceLaw, ImpactResult
 
 __all__ = ["NOMINAL_IMPACT_SPEED", "nominal_parameters", "ring_impact"]
 
@@ -56,6 +58,10 @@ def ring_impact(
 
     Returns the `ImpactResult` of the closed-form ring law (no MuJoCo).
     """
+    # here, not at import: the impact reference needs scipy.integrate (0.3 s to import), and a
+    # calibrated run with its calibration cached never simulates an impact
+    from clearance.contact_calibration.impact import simulate_impact
+
     return simulate_impact(_ring_law(geom, params.stiffness, params.damping, delta_ref), mass=mass, speed=speed)
 
 
@@ -77,6 +83,10 @@ def nominal_parameters(
     Returns:
         ContactParameters with source "nominal".
     """
+    from scipy.optimize import brentq  # here, not at import (see ring_impact)
+
+    from clearance.contact_calibration.impact import law_impact
+
     K = bearing_stiffness(clearance)
     ln = (
         law_impact(

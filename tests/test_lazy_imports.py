@@ -45,6 +45,8 @@ clearance.cli.build_parser().parse_args(["run", "--out", "unused"])
 note("parse")
 import clearance.contact_calibration
 note("contact_calibration")
+import clearance.contact_calibration.fit, clearance.contact_calibration.nominal, clearance.contact_calibration.store
+note("calibration_store")
 from clearance.builders import slider_crank
 from clearance.options import ContactMode, ModelOptions
 from clearance.run.preparation import prepare
@@ -92,6 +94,11 @@ def test_parsing_the_command_line_loads_nothing_costly(loaded):
 def test_the_contact_package_loads_its_impact_reference_on_first_use(loaded):
     assert loaded["contact_calibration"] == []
     assert "scipy.integrate" in loaded["impact"]  # the lazy name still works
+
+
+def test_a_cached_calibration_is_read_without_the_fitting_machinery(loaded):
+    # a calibrated run with its calibration cached imports the store (and so fit and nominal)
+    assert loaded["calibration_store"] == [] and loaded["calibration_store/scipy"] == []
 
 
 def test_preparing_and_simulating_a_run_loads_nothing_costly(loaded):
