@@ -8,6 +8,7 @@
     clearance sweep      bifurcation diagram over clearance or drive speed (resumable)
     clearance rank       joint criticality ranking (resumable)
     clearance bench      speed against error of MuJoCo settings (resumable)
+    clearance retrofit   give hinges of any MuJoCo model radial clearance (ring bearings)
 
 One module per command; `clearance.cli.options` holds the options they share and is the one
 place units (mm, rpm, µs, ms) are converted to SI. Nothing below this package imports it.
@@ -45,7 +46,13 @@ _OWN_PARSER = {
 }
 """Commands with a parser of their own: name -> (module, entry point, help)."""
 
-_SUBPARSERS = ("clearance.cli.run", "clearance.cli.reference", "clearance.cli.mjcf", "clearance.cli.view")
+_SUBPARSERS = (
+    "clearance.cli.run",
+    "clearance.cli.reference",
+    "clearance.cli.mjcf",
+    "clearance.cli.view",
+    "clearance.cli.retrofit",
+)
 """Modules whose command is parsed here; each has ``add_parser(sub)`` and ``command(args)``."""
 
 

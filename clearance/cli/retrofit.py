@@ -1,0 +1,305 @@
+"""``clearance retrofit``: radial clearance at hinges of any MuJoCo model (ring mode).
+
+    clearance retrofit MODEL.xml --joint NAME [--joint NAME ...] --out DIR
+
+writes DIR/model.xml (the retrofitted model: stock MuJoCo opens it), DIR/original.xml (the
+unmodified model, saved with the same asset-path fixes) and DIR/retrofit.md (every change,
+the sizing, the calibration, the time step and the speed cost). The options below set every
+hinge's play; a hinge's own values follow its name, with units in the keys:
+``--joint elbow:clearance_mm=0.2,bearing_radius_mm=8,youngs_modulus_gpa=2.4``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import os
+from collections.abc import Callable
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from clearance.cli.options import positive, si
+from clearance.model import ContactLaw, Material
+from clearance.units import UNITS
+
+if TYPE_CHECKING:
+    from clearance.retrofit import RadialPlay
+
+__all__ = ["add_parser", "command", "JOINT_KEYS"]
+
+JOINT_KEYS = {
+    "clearance_mm": "--clearance-mm",
+    "bearing_radius_mm": "--bearing-radius-mm",
+    "youngs_modulus_gpa": "--youngs-modulus-gpa",
+    "poisson_ratio": "--poisson-ratio",
+    "restitution": "--restitution",
+    "friction": "--friction",
+}
+"""Per-joint keys of ``--joint NAME:key=value,...`` -> the option they override."""
+
+
+def _in_range(name: str, low: float, high: float, *, low_open: bool, high_open: bool) -> Callable[[str], float]:
+    """An argparse ``type``: a finite float in the interval, the message naming ``name``."""
+    left, right = ("(" if low_open else "["), (")" if high_open else "]")
+
+    def conv(text: str) -> float:
+        try:
+            v = float(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
+        ok = math.isfinite(v) and (v > low if low_open else v >= low) and (v < high if high_open else v <= high)
+        if not ok:
+            raise argparse.ArgumentTypeError(
+                f"{name} must be a finite number in {left}{low:g}, {high:g}{right} (got {text})"
+            )
+        return v
+
+    return conv
+
+
+def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
+    """Add ``retrofit`` to the subcommands ``sub`` (argparse's subparsers action)."""
+    from clearance.retrofit import DEFAULT_BEARING_RADIUS, DEFAULT_RADIAL_CLEARANCE
+
+    p = sub.add_parser(
+        "retrofit",
+        help="give hinges of any MuJoCo model radial clearance (a journal in a calibrated ring bearing)",
+        description=(__doc__ or "").split("\n\n")[0],
+    )
+    p.add_argument("model", metavar="MODEL.xml", help="the MuJoCo model (MJCF) to retrofit")
+    p.add_argument(
+        "--joint",
+        action="append",
+        required=True,
+        metavar="NAME[:key=value,...]",
+        help="a hinge to give radial play (repeat for more); its own values may follow, keys " + ", ".join(JOINT_KEYS),
+    )
+    p.add_argument("--out", required=True, metavar="DIR", help="output folder")
+    play = p.add_argument_group("play (every hinge, unless its --joint says otherwise)")
+    play.add_argument(
+        "--clearance-mm",
+        type=positive(float, "--clearance-mm"),
+        default=DEFAULT_RADIAL_CLEARANCE * 1e3,
+        help=f"radial clearance c [mm] (default {DEFAULT_RADIAL_CLEARANCE * 1e3:g})",
+    )
+    play.add_argument(
+        "--bearing-radius-mm",
+        type=positive(float, "--bearing-radius-mm"),
+        default=DEFAULT_BEARING_RADIUS * 1e3,
+        help=f"bearing radius R_B [mm] (default {DEFAULT_BEARING_RADIUS * 1e3:g})",
+    )
+    play.add_argument(
+        "--youngs-modulus-gpa",
+        type=positive(float, "--youngs-modulus-gpa"),
+        default=207.0,
+        help="Young's modulus of journal and bearing [GPa] (default 207, steel; about 2-3 for a polymer bushing)",
+    )
+    play.add_argument(
+        "--poisson-ratio",
+        type=_in_range("--poisson-ratio", 0.0, 0.5, low_open=False, high_open=True),
+        default=0.3,
+        help="Poisson's ratio of journal and bearing (default 0.3)",
+    )
+    play.add_argument(
+        "--restitution",
+        type=_in_range("--restitution", 0.0, 1.0, low_open=True, high_open=False),
+        default=0.9,
+        help="coefficient of restitution (default 0.9)",
+    )
+    play.add_argument(
+        "--friction",
+        type=_in_range("--friction", 0.0, math.inf, low_open=False, high_open=True),
+        default=0.0,
+        help="Coulomb friction coefficient (default 0)",
+    )
+    play.add_argument(
+        "--law",
+        default=ContactLaw.LANKARANI_NIKRAVESH.value,
+        choices=[law.value for law in ContactLaw if law is not ContactLaw.IMPACT],
+        help="contact law the ring is calibrated against (default lankarani_nikravesh)",
+    )
+    num = p.add_argument_group("numerics")
+    num.add_argument(
+        "--contact-mode",
+        default="calibrated",
+        choices=("calibrated", "nominal", "exact"),
+        help="calibrated (default: the ring's soft contact fitted to the law at each bearing's effective mass, "
+        "cached) or nominal (formula parameters); exact is not available for retrofits yet",
+    )
+    num.add_argument(
+        "--timestep-us",
+        type=positive(float, "--timestep-us"),
+        default=None,
+        help="time step [µs] (default: the largest 1/2/5 x 10^k with omega*h <= 0.2 at every bearing, "
+        "at most the model's own)",
+    )
+    num.add_argument("--segments", type=int, default=None, help="ring segments per bearing (default: the ripple rule)")
+    num.add_argument("--journal-geom", default="sphere", choices=("sphere", "capsule", "cylinder"))
+    num.add_argument("--segment-geom", default="sphere", choices=("sphere", "capsule", "box", "cylinder"))
+    motion = p.add_argument_group("sizing motion (the unmodified model under a sinusoid on every actuator)")
+    motion.add_argument(
+        "--sine-amplitude",
+        type=_in_range("--sine-amplitude", 0.0, math.inf, low_open=False, high_open=True),
+        default=0.5,
+        help="fraction of each actuator's control half-range (default 0.5)",
+    )
+    motion.add_argument(
+        "--sine-frequency-hz", type=positive(float, "--sine-frequency-hz"), default=1.0, help="[Hz] (default 1)"
+    )
+    motion.add_argument(
+        "--sizing-duration-s", type=positive(float, "--sizing-duration-s"), default=1.0, help="[s] (default 1)"
+    )
+    p.add_argument("--no-speed", action="store_true", help="do not measure the speed cost")
+    p.set_defaults(run_command=command)
+
+
+def _joint_values(args: argparse.Namespace, text: str) -> tuple[str, dict[str, float]]:
+    """(hinge name, its values in command-line units) from ``NAME[:key=value,...]``."""
+    values = {key: float(getattr(args, flag[2:].replace("-", "_"))) for key, flag in JOINT_KEYS.items()}
+    name, sep, rest = text.partition(":")
+    if not name:
+        raise ValueError(f"--joint {text!r}: give the hinge's name first")
+    if not sep:
+        return name, values
+    for item in rest.split(","):
+        key, eq, value = item.partition("=")
+        key = key.strip()
+        if key not in JOINT_KEYS or not eq:
+            raise ValueError(f"--joint {text!r}: '{item}' is not key=value with a key among {', '.join(JOINT_KEYS)}")
+        try:
+            v = float(value)
+        except ValueError:
+            raise ValueError(f"--joint {text!r}: {key} must be a number (got {value!r})") from None
+        if not math.isfinite(v):
+            raise ValueError(f"--joint {text!r}: {key} must be a finite number (got {value!r})")
+        values[key] = v
+    return name, values
+
+
+def plays_from_args(args: argparse.Namespace) -> dict[str, RadialPlay]:
+    """Hinge name -> `RadialPlay` from the options (SI), checked before any work.
+
+    Raises:
+        ValueError: a bad value (named with its option or joint key), a clearance not smaller
+            than the bearing radius, a joint named twice.
+    """
+    from clearance.model import Clearance
+    from clearance.retrofit import RadialPlay
+
+    gpa = UNITS["pressure"]["gpa"]
+    plays: dict[str, RadialPlay] = {}
+    for text in args.joint:
+        name, v = _joint_values(args, text)
+        if name in plays:
+            raise ValueError(f"--joint: hinge '{name}' is named twice")
+        where = f"hinge '{name}'"
+        for key in ("clearance_mm", "bearing_radius_mm", "youngs_modulus_gpa", "restitution"):
+            if not v[key] > 0:
+                raise ValueError(f"{where}: {key} must be > 0 (got {v[key]:g})")
+        if not 0 <= v["poisson_ratio"] < 0.5 or v["friction"] < 0 or v["restitution"] > 1:
+            raise ValueError(
+                f"{where}: poisson_ratio must be in [0, 0.5), friction >= 0 and restitution <= 1 "
+                f"(got {v['poisson_ratio']:g}, {v['friction']:g}, {v['restitution']:g})"
+            )
+        if v["clearance_mm"] >= v["bearing_radius_mm"]:
+            raise ValueError(
+                f"{where}: the radial clearance {v['clearance_mm']:g} mm must be smaller than the bearing radius "
+                f"{v['bearing_radius_mm']:g} mm (--clearance-mm, --bearing-radius-mm)"
+            )
+        material = Material(v["youngs_modulus_gpa"] * gpa, v["poisson_ratio"])
+        clearance = Clearance(
+            si(v["clearance_mm"], "mm"),
+            si(v["bearing_radius_mm"], "mm"),
+            bearing_material=material,
+            journal_material=material,
+            restitution=v["restitution"],
+            friction=v["friction"],
+            law=ContactLaw(args.law),
+        )
+        plays[name] = RadialPlay(clearance)
+    return plays
+
+
+def _check_out(out: Path) -> None:
+    if out.exists() and not out.is_dir():
+        raise ValueError(f"--out {out}: exists and is not a folder")
+    parent = out if out.exists() else next((p for p in out.parents if p.exists()), Path("."))
+    if not os.access(parent, os.W_OK):
+        raise ValueError(f"--out {out}: cannot write in {parent}")
+
+
+def _command_line(args: argparse.Namespace) -> str:
+    parts = ["clearance retrofit", args.model, *[f"--joint {j}" for j in args.joint], f"--out {args.out}"]
+    for flag in (
+        "--clearance-mm",
+        "--bearing-radius-mm",
+        "--youngs-modulus-gpa",
+        "--poisson-ratio",
+        "--restitution",
+        "--friction",
+        "--law",
+        "--contact-mode",
+        "--timestep-us",
+        "--segments",
+        "--journal-geom",
+        "--segment-geom",
+        "--sine-amplitude",
+        "--sine-frequency-hz",
+        "--sizing-duration-s",
+    ):
+        value = getattr(args, flag[2:].replace("-", "_"))
+        if value is not None:
+            parts.append(f"{flag} {value:g}" if isinstance(value, float) else f"{flag} {value}")
+    if args.no_speed:
+        parts.append("--no-speed")
+    return " ".join(parts)
+
+
+def command(args: argparse.Namespace) -> int:
+    """Run ``clearance retrofit``; returns the exit status (2: refused)."""
+    import mujoco
+
+    from clearance.retrofit import RetrofitOptions, SineControl, retrofit, write_retrofit
+
+    plays = plays_from_args(args)
+    options = RetrofitOptions(
+        contact_mode=args.contact_mode,
+        segments=args.segments,
+        journal_geom=args.journal_geom,
+        segment_geom=args.segment_geom,
+        timestep=None if args.timestep_us is None else si(args.timestep_us, "us"),
+        control=SineControl(args.sine_amplitude, args.sine_frequency_hz),
+        sizing_duration=args.sizing_duration_s,
+        measure_speed=not args.no_speed,
+    )
+    out = Path(args.out)
+    _check_out(out)
+    path = Path(args.model)
+    if not path.is_file():
+        raise ValueError(f"model file {path} does not exist" if not path.exists() else f"{path} is not a file")
+    try:
+        spec = mujoco.MjSpec.from_file(str(path))
+    except ValueError as err:
+        raise ValueError(f"model file {path} cannot be read by MuJoCo: {err}") from None
+    try:
+        result = retrofit(spec, plays, options)
+    except ValueError as err:
+        raise ValueError(f"{path}: {err}") from None
+    paths = write_retrofit(result, out, source_dir=path.resolve().parent, source=str(path), command=_command_line(args))
+    for h in result.hinges.values():
+        s = h.sizing
+        print(
+            f"{h.name}: c = {h.play.clearance.radial_clearance * 1e3:g} mm, {s.segments} segments, effective mass "
+            f"{s.effective_mass:.3g} kg, peak load {s.peak_load:.3g} N, contact {h.contact.parameters.source}"
+        )
+    print(f"time step {result.timestep:g} s (the model's own {result.twin.opt.timestep:g} s)")
+    if result.speed is not None:
+        print(
+            f"speed cost: {result.speed.retrofitted.steps_per_second:,.0f} steps/s against "
+            f"{result.speed.unmodified.steps_per_second:,.0f}; one simulated second takes "
+            f"{result.speed.per_simulated_second:.3g}x as long"
+        )
+    for note in result.notes:
+        print(f"note: {note}")
+    print("wrote " + ", ".join(str(p) for p in paths.values()))
+    return 0

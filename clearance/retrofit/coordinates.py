@@ -1,0 +1,129 @@
+"""Coordinates of the unmodified model inside the retrofitted one, and keyframes extended.
+
+The retrofitted model has the unmodified model's joints in the same order, with two slides
+inserted before each retrofitted hinge. `CoordinateMap` holds where each of the unmodified
+model's qpos and qvel entries went, and where each hinge's slides are, so a state of one
+model becomes a state of the other.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+__all__ = ["CoordinateMap", "coordinate_map", "check_map", "extend_keyframes"]
+
+_NQ = {
+    mujoco.mjtJoint.mjJNT_FREE: 7,
+    mujoco.mjtJoint.mjJNT_BALL: 4,
+    mujoco.mjtJoint.mjJNT_SLIDE: 1,
+    mujoco.mjtJoint.mjJNT_HINGE: 1,
+}
+_NV = {
+    mujoco.mjtJoint.mjJNT_FREE: 6,
+    mujoco.mjtJoint.mjJNT_BALL: 3,
+    mujoco.mjtJoint.mjJNT_SLIDE: 1,
+    mujoco.mjtJoint.mjJNT_HINGE: 1,
+}
+
+
+@dataclass(frozen=True)
+class CoordinateMap:
+    """Where the unmodified model's coordinates sit in the retrofitted model.
+
+    Attributes:
+        qpos: (nq_twin,) index in the retrofitted qpos of each unmodified qpos entry.
+        qvel: (nv_twin,) likewise for qvel (and every per-dof array).
+        slide_qpos: hinge name -> (2,) qpos indices of its x and y slides.
+        slide_dof: hinge name -> (2,) dof indices of its x and y slides.
+        nq, nv: sizes of the retrofitted model.
+    """
+
+    qpos: np.ndarray
+    qvel: np.ndarray
+    slide_qpos: dict[str, np.ndarray]
+    slide_dof: dict[str, np.ndarray]
+    nq: int
+    nv: int
+
+    def model_qpos(self, twin_qpos: np.ndarray, offsets: Mapping[str, tuple[float, float]] | None = None) -> np.ndarray:
+        """A retrofitted qpos from an unmodified one, each journal at ``offsets`` (default centred)."""
+        q = np.zeros(self.nq)
+        q[self.qpos] = twin_qpos
+        for name, e in (offsets or {}).items():
+            q[self.slide_qpos[name]] = e
+        return q
+
+    def model_qvel(self, twin_qvel: np.ndarray) -> np.ndarray:
+        """A retrofitted qvel from an unmodified one (journals at rest in their bearings)."""
+        v = np.zeros(self.nv)
+        v[self.qvel] = twin_qvel
+        return v
+
+
+def coordinate_map(twin: mujoco.MjModel, hinges: Mapping[str, int]) -> CoordinateMap:
+    """Where the unmodified coordinates go once each hinge in ``hinges`` gets two slides before it.
+
+    Compiled joints follow the body tree and each body's joint order, so every joint moves
+    by two places per retrofitted hinge at or before it (a hinge's own slides come first).
+
+    Args:
+        twin: the unmodified model.
+        hinges: hinge name -> its joint id in ``twin``.
+    """
+    ids = sorted(hinges.values())
+    qpos = np.zeros(twin.nq, dtype=int)
+    qvel = np.zeros(twin.nv, dtype=int)
+    for j in range(twin.njnt):
+        kind = mujoco.mjtJoint(int(twin.jnt_type[j]))
+        shift = 2 * sum(1 for h in ids if h <= j)
+        a = int(twin.jnt_qposadr[j])
+        qpos[a : a + _NQ[kind]] = np.arange(a, a + _NQ[kind]) + shift
+        a = int(twin.jnt_dofadr[j])
+        qvel[a : a + _NV[kind]] = np.arange(a, a + _NV[kind]) + shift
+    return CoordinateMap(
+        qpos,
+        qvel,
+        {n: qpos[twin.jnt_qposadr[j]] - np.array([2, 1]) for n, j in hinges.items()},
+        {n: qvel[twin.jnt_dofadr[j]] - np.array([2, 1]) for n, j in hinges.items()},
+        int(twin.nq) + 2 * len(ids),
+        int(twin.nv) + 2 * len(ids),
+    )
+
+
+def check_map(cmap: CoordinateMap, model: mujoco.MjModel, slides: Mapping[str, tuple[str, str]]) -> None:
+    """Check the map against the compiled retrofitted model: sizes and each hinge's slides.
+
+    Raises:
+        RuntimeError: the compiled model's coordinates are not where the map puts them.
+    """
+    if (model.nq, model.nv) != (cmap.nq, cmap.nv):
+        raise RuntimeError(f"retrofitted model has nq, nv = {model.nq}, {model.nv}; expected {cmap.nq}, {cmap.nv}")
+    for hinge, names in slides.items():
+        for k, name in enumerate(names):
+            jid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, name)
+            if jid < 0 or model.jnt_qposadr[jid] != cmap.slide_qpos[hinge][k]:
+                raise RuntimeError(f"slide '{name}' of hinge '{hinge}' is not where the coordinate map puts it")
+
+
+def extend_keyframes(
+    spec: mujoco.MjSpec,
+    twin: mujoco.MjModel,
+    cmap: CoordinateMap,
+    offsets: Mapping[str, tuple[float, float]],
+) -> int:
+    """Rewrite every keyframe of ``spec`` for the retrofitted coordinates; returns their count.
+
+    Each keyframe's qpos and qvel become full vectors of the retrofitted model: the
+    unmodified keyframe's values (as the unmodified model compiled them, so an omitted qpos
+    is its qpos0) in their new places, each journal at its offset in the bearing frame and
+    at rest relative to it. Time, act, ctrl and mocap poses are untouched.
+    """
+    keys = list(spec.keys)
+    for k, key in enumerate(keys):
+        key.qpos = list(cmap.model_qpos(twin.key_qpos[k], offsets))
+        key.qvel = list(cmap.model_qvel(twin.key_qvel[k]))
+    return len(keys)

@@ -1,0 +1,155 @@
+"""The elements a retrofit adds to a hinge: slides, sites, journal, ring, pairs and sensors.
+
+For hinge ``J`` (prefix ``clr_J``): slides ``clr_J__x`` and ``clr_J__y`` before the hinge in
+the child body; sites ``clr_J__journal`` (child) and ``clr_J__bearing`` (parent) at the
+hinge position with the bearing frame's axes; the journal geom ``clr_J__journal``, the ring
+``clr_J__segNNN`` on the parent and the pairs ``clr_J__pairNNN`` (`clearance.mjcf.bearing_geoms`,
+the same as a mechanism's); sensors ``clr_J__ecc`` (journal centre in the bearing frame) and
+``clr_J__force`` (net contact force on the journal). All in the class `DEFAULT_CLASS`,
+massless and colliding through their pairs only. Sensors are appended after the model's own,
+so its sensor data keeps its layout.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import mujoco
+
+from clearance.mjcf.bearing import RingGeometry
+from clearance.mjcf.bearing_geoms import Placement, RingElements, add_journal_and_bearing
+from clearance.options import ModelOptions
+from clearance.retrofit.elements import rebuild_hinge_after_slides
+from clearance.retrofit.frames import BearingFrame
+from clearance.retrofit.play import PREFIX
+
+__all__ = ["PlayElements", "prefix_of", "add_slides_and_sites", "add_bearing"]
+
+_SITE_SIZE = [0.001, 0.0, 0.0]
+_SENS = mujoco.mjtSensor
+_OBJ = mujoco.mjtObj
+
+
+def prefix_of(hinge: str) -> str:
+    """The name prefix of everything added for ``hinge``."""
+    return f"{PREFIX}{hinge}"
+
+
+@dataclass
+class PlayElements:
+    """Names of the elements added for one hinge.
+
+    Attributes:
+        hinge: the hinge.
+        slides: its x and y slides.
+        journal_site, bearing_site: the sites at the journal and bearing centres.
+        journal_body, bearing_body: the bodies holding them (name, or ``#id`` if unnamed).
+        journal_geom: the journal geom ('' until the ring is added).
+        segments: the ring's segment geoms.
+        pairs: the journal-segment pairs.
+        sensors: the sensors added.
+    """
+
+    hinge: str
+    slides: tuple[str, str]
+    journal_site: str
+    bearing_site: str
+    journal_body: str
+    bearing_body: str
+    journal_geom: str = ""
+    segments: list[str] = field(default_factory=list)
+    pairs: list[str] = field(default_factory=list)
+    sensors: list[str] = field(default_factory=list)
+
+
+def _site(body: mujoco.MjsBody, name: str, place: Placement, default: mujoco.MjsDefault) -> None:
+    body.add_site(
+        default=default,
+        name=name,
+        pos=place.point(0.0, 0.0),
+        size=_SITE_SIZE,
+        group=3,
+        **place.orientation(),
+    )
+
+
+def _label(body: mujoco.MjsBody) -> str:
+    return body.name or f"#{body.id}"
+
+
+def add_slides_and_sites(
+    spec: mujoco.MjSpec,
+    hinge: mujoco.MjsJoint,
+    bearing_body: mujoco.MjsBody,
+    frame: BearingFrame,
+    default: mujoco.MjsDefault,
+) -> PlayElements:
+    """Put the slides before the hinge and the two centre sites; returns the names added.
+
+    Args:
+        spec: the spec being edited.
+        hinge: the hinge (the only joint of its body).
+        bearing_body: the parent body in the spec (the body the compiled model's parent is).
+        frame: the hinge's bearing frame.
+        default: the retrofit's default class.
+    """
+    prefix = prefix_of(hinge.name)
+    journal_body = hinge.parent
+    name = hinge.name
+    slides, _ = rebuild_hinge_after_slides(
+        spec, hinge, prefix, frame.journal.point(0.0, 0.0), frame.axes[:, :2].T, default
+    )
+    _site(journal_body, f"{prefix}__journal", frame.journal, default)
+    _site(bearing_body, f"{prefix}__bearing", frame.bearing, default)
+    return PlayElements(
+        name,
+        (slides[0].name, slides[1].name),
+        f"{prefix}__journal",
+        f"{prefix}__bearing",
+        _label(journal_body),
+        _label(bearing_body),
+    )
+
+
+def add_bearing(
+    spec: mujoco.MjSpec,
+    elements: PlayElements,
+    journal_body: mujoco.MjsBody,
+    bearing_body: mujoco.MjsBody,
+    frame: BearingFrame,
+    ring: RingGeometry,
+    options: ModelOptions,
+    friction: float,
+    default: mujoco.MjsDefault,
+) -> RingElements:
+    """Add the journal, ring, pairs and sensors of one hinge; fills ``elements``' names."""
+    prefix = prefix_of(elements.hinge)
+    added = add_journal_and_bearing(
+        spec,
+        journal_body,
+        bearing_body,
+        prefix,
+        frame.journal,
+        frame.bearing,
+        ring,
+        options,
+        friction,
+        default=default,
+    )
+    elements.journal_geom = added.journal.name
+    elements.segments = [g.name for g in added.segments]
+    elements.pairs = [p.name for p in added.pairs]
+    ecc = spec.add_sensor(
+        name=f"{prefix}__ecc",
+        type=_SENS.mjSENS_FRAMEPOS,
+        objtype=_OBJ.mjOBJ_SITE,
+        objname=elements.journal_site,
+    )
+    ecc.reftype = _OBJ.mjOBJ_SITE
+    ecc.refname = elements.bearing_site
+    force = spec.add_sensor(
+        name=f"{prefix}__force", type=_SENS.mjSENS_CONTACT, objtype=_OBJ.mjOBJ_GEOM, objname=added.journal.name
+    )
+    force.intprm[:3] = [2, 3, 1]  # data = force, reduce = netforce, num = 1
+    elements.sensors = [ecc.name, force.name]
+    return added

@@ -1,0 +1,69 @@
+"""Writing a retrofit: the model, its unmodified twin and the report, each atomically.
+
+``model.xml`` (the retrofitted model, ring mode: stock MuJoCo compiles it), ``original.xml``
+(the unmodified model with the same asset-path fixes, for comparison runs) and
+``retrofit.md`` (every change; `clearance.retrofit.report`). The written model is compiled
+again from its file before the report is written, so a model that would not load is never
+reported as done.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import mujoco
+
+from clearance.results import atomic_write_text
+from clearance.retrofit.assets import relocate_assets
+from clearance.retrofit.pipeline import Retrofit
+from clearance.retrofit.report import retrofit_report
+
+__all__ = ["MODEL_FILE", "TWIN_FILE", "REPORT_FILE", "write_retrofit"]
+
+MODEL_FILE = "model.xml"
+TWIN_FILE = "original.xml"
+REPORT_FILE = "retrofit.md"
+
+
+def write_retrofit(
+    result: Retrofit,
+    out_dir: str | os.PathLike[str],
+    *,
+    source_dir: str | os.PathLike[str] | None = None,
+    source: str = "",
+    command: str = "",
+) -> dict[str, Path]:
+    """Write ``model.xml``, ``original.xml`` and ``retrofit.md`` into ``out_dir``.
+
+    Args:
+        result: the retrofit.
+        out_dir: the output folder (created if missing).
+        source_dir: the folder the model was read from (default: the spec's own
+            ``modelfiledir``, else the current folder); asset folders are rewritten from it.
+        source: the model file, for the report.
+        command: the command line, for the report.
+
+    Returns:
+        File role ('model', 'original', 'report') -> path.
+
+    Raises:
+        RuntimeError: the written model does not compile from its file.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    src = Path(source_dir if source_dir is not None else (result.twin_spec.modelfiledir or "."))
+    paths = {"model": out / MODEL_FILE, "original": out / TWIN_FILE, "report": out / REPORT_FILE}
+    changes: list[str] = []
+    for role, spec in (("model", result.spec), ("original", result.twin_spec)):
+        copy = spec.copy()
+        found = relocate_assets(copy, src, out)
+        if role == "model":
+            changes = found
+        atomic_write_text(paths[role], copy.to_xml())
+    try:
+        mujoco.MjModel.from_xml_path(str(paths["model"]))
+    except ValueError as err:
+        raise RuntimeError(f"the written model {paths['model']} does not compile: {err}") from None
+    atomic_write_text(paths["report"], retrofit_report(result, source=source, command=command, asset_changes=changes))
+    return paths

@@ -1,0 +1,294 @@
+"""`retrofit`: give hinges of any MuJoCo model radial play, in ring mode.
+
+Steps (each in its own module): check the request (`selection`); run the unmodified model
+under the sizing control and read its hinge loads (`motion`); put two slides before each
+hinge and the centre sites (`insertion`, `elements`, `frames`), extend the keyframes
+(`coordinates`); measure each bearing's effective mass along its load and size it, choose
+the segment count and the time step (`sizing`); calibrate its contact (`contact`); add the
+ring, pairs and sensors; compile; check that no body's mass or inertia moved; measure the
+speed cost (`speed`).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import time
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from clearance.mjcf.bearing import RingGeometry
+from clearance.mjcf.spec import ring_geometry
+from clearance.model import Joint, JointType
+from clearance.options import GeomType, ModelOptions
+from clearance.retrofit.contact import PlayContact, play_contact, row_inverse_weight, write_pair_contact
+from clearance.retrofit.coordinates import CoordinateMap, check_map, coordinate_map, extend_keyframes
+from clearance.retrofit.elements import add_builtin_class
+from clearance.retrofit.frames import BearingFrame, bearing_frame
+from clearance.retrofit.insertion import PlayElements, add_bearing, add_slides_and_sites
+from clearance.retrofit.motion import Motion, twin_motion
+from clearance.retrofit.play import RadialPlay, RetrofitError, RetrofitOptions
+from clearance.retrofit.selection import Hinge, compile_model, model_label, select_hinges
+from clearance.retrofit.sizing import (
+    PlayMass,
+    PlaySizing,
+    check_time_step,
+    choose_time_step,
+    effective_masses,
+    size_play,
+)
+from clearance.retrofit.speed import SpeedCost, measure_speed
+
+__all__ = ["RetrofittedHinge", "Retrofit", "retrofit", "INTEGRATORS"]
+
+INTEGRATORS = {
+    mujoco.mjtIntegrator.mjINT_EULER: "euler",
+    mujoco.mjtIntegrator.mjINT_RK4: "rk4",
+    mujoco.mjtIntegrator.mjINT_IMPLICIT: "implicit",
+    mujoco.mjtIntegrator.mjINT_IMPLICITFAST: "implicitfast",
+}
+"""MuJoCo integrators by the names `ModelOptions` uses."""
+
+
+@dataclass
+class RetrofittedHinge:
+    """One hinge with radial play.
+
+    Attributes:
+        name: the hinge.
+        play: its play (physics).
+        hinge: where it sits (joint and body ids, the same in both models).
+        frame: its bearing frame.
+        elements: names of what was added for it.
+        ring: the ring's geometry.
+        mass: effective mass over the motion.
+        sizing: loads, sizes, segment count and contact frequency.
+        contact: contact parameters and their source.
+        model_options: the options its ring was built and calibrated with (segments, geoms,
+            time step, integrator, impedance, contact mode).
+    """
+
+    name: str
+    play: RadialPlay
+    hinge: Hinge
+    frame: BearingFrame
+    elements: PlayElements
+    ring: RingGeometry
+    mass: PlayMass
+    sizing: PlaySizing
+    contact: PlayContact
+    model_options: ModelOptions
+
+
+@dataclass
+class Retrofit:
+    """A retrofitted model, its unmodified twin and everything a report needs.
+
+    Attributes:
+        spec: the retrofitted spec (ring mode: stock MuJoCo compiles it).
+        model: ``spec`` compiled.
+        twin_spec: the unmodified spec (a copy: the caller's spec is not changed).
+        twin: ``twin_spec`` compiled.
+        hinges: hinge name -> its play, elements, sizing and contact, in the order given.
+        options: the numerical choices.
+        integrator: the model's integrator (kept), by `ModelOptions`' name.
+        timestep: the retrofitted model's time step [s].
+        cmap: where the unmodified coordinates sit in the retrofitted model.
+        motion: the unmodified model's sizing motion.
+        keyframes: keyframes extended.
+        speed: the speed cost (None when not measured).
+        notes: remarks for the report (a segment rule's fallback, warnings of the motion).
+        timings: wall time per phase [s]: 'checks', 'sizing motion', 'spec edit and
+            compiles', 'effective masses', 'segment rule', 'contact parameters', 'speed'.
+    """
+
+    spec: mujoco.MjSpec
+    model: mujoco.MjModel
+    twin_spec: mujoco.MjSpec
+    twin: mujoco.MjModel
+    hinges: dict[str, RetrofittedHinge]
+    options: RetrofitOptions
+    integrator: str
+    timestep: float
+    cmap: CoordinateMap
+    motion: Motion
+    keyframes: int
+    speed: SpeedCost | None = None
+    notes: list[str] = field(default_factory=list)
+    timings: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def wall_time(self) -> float:
+        """Wall time of the retrofit without the speed measurement [s]."""
+        return sum(t for phase, t in self.timings.items() if phase != "speed")
+
+
+def _check_plays(joints: Mapping[str, RadialPlay]) -> None:
+    for name, play in joints.items():
+        if not isinstance(name, str) or not name:
+            raise RetrofitError(f"hinge names must be non-empty strings (got {name!r})")
+        if not isinstance(play, RadialPlay):
+            raise RetrofitError(f"the play of hinge '{name}' must be a RadialPlay (got {play!r})")
+
+
+def _spec_bodies(spec: mujoco.MjSpec) -> dict[int, mujoco.MjsBody]:
+    """Spec bodies by the id the last compile gave them."""
+    return {int(b.id): b for b in spec.bodies}
+
+
+def _mass_properties(model: mujoco.MjModel) -> np.ndarray:
+    return np.concatenate(
+        [model.body_mass, model.body_inertia.ravel(), model.body_ipos.ravel(), model.body_iquat.ravel()]
+    )
+
+
+def _ring(play: RadialPlay, segments: int, options: ModelOptions) -> RingGeometry:
+    joint = Joint("hinge", JointType.REVOLUTE, "parent", "centre", "child", "centre", clearance=play.clearance)
+    return ring_geometry(joint, segments, options)
+
+
+def retrofit(
+    spec: mujoco.MjSpec,
+    joints: Mapping[str, RadialPlay],
+    options: RetrofitOptions | None = None,
+) -> Retrofit:
+    """Give each named hinge of ``spec`` radial play: a journal in a calibrated ring bearing.
+
+    The child body of each hinge keeps its hinge and gains two slides before it, in the
+    plane normal to the hinge axis through the hinge position (the bearing frame); the
+    parent body gets the ring, the child the journal, with explicit contact pairs between
+    them only. Everything else of the model is kept: bodies, masses and inertias, actuators,
+    sensors (new ones are appended), keyframes (extended for the slides), defaults, assets,
+    equality constraints, the integrator. The time step becomes the one the stability rule
+    chooses (`clearance.retrofit.sizing`) unless ``options.timestep`` is given.
+
+    Args:
+        spec: the user's model (not changed: the retrofit edits a copy).
+        joints: hinge name -> its play, in the order the report lists them.
+        options: numerical choices (default `RetrofitOptions()`).
+
+    Returns:
+        The retrofitted model, its twin and what was measured and added.
+
+    Raises:
+        RetrofitError: a bad request or model, before any work (see `select_hinges`); a
+            time step too large for a bearing.
+        CalibrationStabilityError: a fitted contact unstable at the time step.
+    """
+    options = options or RetrofitOptions()
+    clock = _Clock()
+    with clock("checks"):
+        _check_plays(joints)
+        twin_spec = spec.copy()
+        twin = compile_model(twin_spec)
+        hinges = select_hinges(twin_spec, twin, list(joints))
+    notes: list[str] = []
+    with clock("sizing motion"):
+        data = mujoco.MjData(twin)
+        mujoco.mj_kinematics(twin, data)
+        frames = {h.name: bearing_frame(twin, data, h.joint_id) for h in hinges}
+        motion = twin_motion(twin, hinges, frames, options.control, options.sizing_duration)
+    if motion.warnings:
+        notes.append(
+            f"the unmodified model raised MuJoCo warnings {motion.warnings} during the sizing motion "
+            f"({len(motion.times)} steps kept)"
+        )
+
+    with clock("spec edit and compiles"):
+        work = spec.copy()
+        compile_model(work)  # gives the work spec's elements the compiled ids the twin has
+        bodies = _spec_bodies(work)
+        cls = add_builtin_class(work)
+        elements: dict[str, PlayElements] = {}
+        for h in hinges:
+            if h.parent_id not in bodies:
+                raise RetrofitError(f"the parent body of hinge '{h.name}' is not in the spec of {model_label(spec)}")
+            elements[h.name] = add_slides_and_sites(work, work.joint(h.name), bodies[h.parent_id], frames[h.name], cls)
+        cmap = coordinate_map(twin, {h.name: h.joint_id for h in hinges})
+        offsets = {h.name: joints[h.name].initial_eccentricity for h in hinges}
+        nkeys = extend_keyframes(work, twin, cmap, offsets)
+        kinematic = compile_model(work)
+        check_map(cmap, kinematic, {n: e.slides for n, e in elements.items()})
+
+    with clock("effective masses"):
+        masses = effective_masses(kinematic, cmap, hinges, frames, motion)
+    sizings: dict[str, PlaySizing] = {}
+    with clock("segment rule"):
+        for h in hinges:
+            sizings[h.name], rule_notes = size_play(
+                joints[h.name].clearance,
+                motion.load_size(h.name),
+                masses[h.name],
+                segments=options.segments,
+                ripple_limit=options.ripple_limit,
+                flat=options.segment_geom is GeomType.BOX,
+            )
+            notes += [f"hinge '{h.name}': {n}" for n in rule_notes]
+    h_model = float(twin.opt.timestep)
+    step = options.timestep if options.timestep is not None else choose_time_step(sizings, h_model)
+    for name, s in sizings.items():
+        check_time_step(name, s, step)
+
+    integrator = INTEGRATORS.get(mujoco.mjtIntegrator(int(twin.opt.integrator)), "implicitfast")
+    done: dict[str, RetrofittedHinge] = {}
+    for h in hinges:
+        play, sizing = joints[h.name], sizings[h.name]
+        model_options = ModelOptions(
+            segments=sizing.segments,
+            journal_geom=options.journal_geom,
+            segment_geom=options.segment_geom,
+            timestep=step,
+            integrator=integrator,
+            contact_mode=options.contact_mode,
+            ripple_limit=options.ripple_limit,
+            impedance=options.impedance,
+        )
+        ring = _ring(play, sizing.segments, model_options)
+        with clock("contact parameters"):
+            contact = play_contact(play.clearance, ring, sizing, model_options, use_cache=options.use_cache)
+        with clock("spec edit and compiles"):
+            added = add_bearing(
+                work,
+                elements[h.name],
+                work.joint(h.name).parent,
+                bodies[h.parent_id],
+                frames[h.name],
+                ring,
+                model_options,
+                play.clearance.friction,
+                cls,
+            )
+            a_hat = row_inverse_weight(kinematic, h.child_id, h.parent_id)
+            write_pair_contact(added.pairs, contact.parameters, a_hat, play.clearance.radial_clearance)
+        done[h.name] = RetrofittedHinge(
+            h.name, play, h, frames[h.name], elements[h.name], ring, masses[h.name], sizing, contact, model_options
+        )
+    with clock("spec edit and compiles"):
+        work.option.timestep = step
+        model = compile_model(work)
+    if not np.array_equal(_mass_properties(model), _mass_properties(twin)):
+        raise RuntimeError("the retrofit changed a body's mass or inertia (new geoms must be massless)")
+    speed = None
+    if options.measure_speed:
+        with clock("speed"):
+            speed = SpeedCost(measure_speed(twin, options.control), measure_speed(model, options.control))
+    return Retrofit(
+        work, model, twin_spec, twin, done, options, integrator, step, cmap, motion, nkeys, speed, notes, clock.times
+    )
+
+
+class _Clock:
+    """Wall time per named phase, summed over its entries."""
+
+    def __init__(self) -> None:
+        self.times: dict[str, float] = {}
+
+    @contextlib.contextmanager
+    def __call__(self, phase: str) -> Iterator[None]:
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.times[phase] = self.times.get(phase, 0.0) + time.perf_counter() - t0

@@ -1,0 +1,203 @@
+"""What a retrofit is asked for: the radial play of each hinge, and the numerical choices.
+
+`RadialPlay` holds the physics of one hinge's play (a `clearance.model.Clearance`: radial
+clearance, bearing radius, materials, restitution, friction, contact law) and where the
+journal starts in its bearing. `RetrofitOptions` holds the choices that are not physics:
+contact mode, segments and geoms of the ring, the time step (chosen by the stability rule
+unless given), and the motion the loads and masses are sized from.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from clearance.checks import finite, positive
+from clearance.model import STEEL, Clearance, ContactLaw, Material
+from clearance.options import ContactMode, GeomType
+
+__all__ = [
+    "DEFAULT_BEARING_RADIUS",
+    "DEFAULT_CLASS",
+    "DEFAULT_RADIAL_CLEARANCE",
+    "PREFIX",
+    "RadialPlay",
+    "RetrofitError",
+    "RetrofitOptions",
+    "SineControl",
+]
+
+PREFIX = "clr_"
+"""Every element a retrofit adds is named ``clr_<hinge>__...``."""
+
+DEFAULT_CLASS = "clr_retrofit"
+"""The default class of every element a retrofit adds: MuJoCo's built-in values, so that the
+model's own defaults (a joint damping, a geom margin or density) do not reach them."""
+
+DEFAULT_RADIAL_CLEARANCE = 1e-4
+"""Radial clearance c when none is given [m] (0.1 mm)."""
+
+DEFAULT_BEARING_RADIUS = 0.010
+"""Bearing radius R_B when none is given [m] (10 mm, the catalogue's)."""
+
+
+class RetrofitError(ValueError):
+    """A model or a request that cannot be retrofitted; the message names the joint, file or value."""
+
+
+@dataclass(frozen=True)
+class RadialPlay:
+    """Radial play of one hinge: a journal on the child body inside a bearing on the parent.
+
+    Attributes:
+        clearance: physics of the play (its ``journal_link`` must be None: the hinge's child
+            body always holds the journal). Defaults: c = 0.1 mm, R_B = 10 mm, steel on
+            steel, restitution 0.9, no friction, Lankarani-Nikravesh.
+        initial_eccentricity: the journal centre in the bearing frame (x, y) [m] that the
+            model's keyframes start from; (0, 0): centred. Its size must be below c.
+    """
+
+    clearance: Clearance = field(default_factory=lambda: Clearance(DEFAULT_RADIAL_CLEARANCE, DEFAULT_BEARING_RADIUS))
+    initial_eccentricity: tuple[float, float] = (0.0, 0.0)
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.clearance, Clearance):
+            raise RetrofitError(f"clearance must be a clearance.model.Clearance (got {self.clearance!r})")
+        if self.clearance.journal_link is not None:
+            raise RetrofitError(
+                f"clearance.journal_link must be None in a retrofit: the hinge's child body holds the journal "
+                f"(got {self.clearance.journal_link!r})"
+            )
+        try:
+            ex, ey = self.initial_eccentricity
+        except (TypeError, ValueError):
+            raise RetrofitError(
+                f"initial_eccentricity must be a pair (x, y) in metres (got {self.initial_eccentricity!r})"
+            ) from None
+        e = (finite("initial_eccentricity[0]", ex), finite("initial_eccentricity[1]", ey))
+        c = self.clearance.radial_clearance
+        size = math.hypot(*e)
+        if size >= c:
+            raise RetrofitError(
+                f"initial_eccentricity must be smaller than the radial clearance {c:g} m (got |e| = {size:g} m)"
+            )
+        object.__setattr__(self, "initial_eccentricity", e)
+
+    @classmethod
+    def make(
+        cls,
+        radial_clearance: float = DEFAULT_RADIAL_CLEARANCE,
+        bearing_radius: float = DEFAULT_BEARING_RADIUS,
+        *,
+        bearing_material: Material = STEEL,
+        journal_material: Material = STEEL,
+        restitution: float = 0.9,
+        friction: float = 0.0,
+        law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH,
+        initial_eccentricity: tuple[float, float] = (0.0, 0.0),
+    ) -> RadialPlay:
+        """A play from its numbers (SI units); raises `ValueError` naming a bad one."""
+        c = Clearance(
+            radial_clearance,
+            bearing_radius,
+            bearing_material=bearing_material,
+            journal_material=journal_material,
+            restitution=restitution,
+            friction=friction,
+            law=law,
+        )
+        return cls(c, initial_eccentricity)
+
+
+@dataclass(frozen=True)
+class SineControl:
+    """A sinusoid on every actuator: the motion a retrofit sizes its bearings from.
+
+    Actuator k gets ``mid_k + a_k sin(2π f t + 2π k / nu)``: for an actuator with a control
+    range, mid_k is the range's middle and a_k = ``amplitude`` x its half-width; without a
+    range, mid_k = 0 and a_k = ``amplitude`` in the actuator's own units. The phases are
+    spread so the actuators do not all push at once.
+
+    Attributes:
+        amplitude: fraction of each control range's half-width [-] (or the control's own units).
+        frequency: f [Hz].
+    """
+
+    amplitude: float = 0.5
+    frequency: float = 1.0
+
+    def __post_init__(self) -> None:
+        a = finite("amplitude", self.amplitude)
+        if a < 0:
+            raise RetrofitError(f"amplitude must be >= 0 (got {self.amplitude!r})")
+        positive("frequency", self.frequency, "Hz")
+
+
+@dataclass(frozen=True)
+class RetrofitOptions:
+    """Numerical choices of a retrofit (not physics).
+
+    Attributes:
+        contact_mode: NOMINAL or CALIBRATED (default: the ring's soft contact fitted to the
+            contact law at each bearing's own effective mass and impact speeds). The compiled
+            exact contact is not offered for retrofits yet.
+        segments: ring segments N per bearing; None: the ripple rule
+            (`clearance.mjcf.choose_segments`) at each bearing's typical penetration.
+        journal_geom, segment_geom: geom types of journal and segments.
+        timestep: the retrofitted model's time step [s]; None: chosen by the stability rule
+            (`clearance.retrofit.sizing.choose_time_step`), never above the model's own.
+        ripple_limit: largest ring force ripple the segment rule allows [-].
+        impedance: constant solimp impedance d of the contact rows [-].
+        control: the motion of the unmodified model that loads, masses and impact speeds
+            are sized from, and that the speed cost is measured on.
+        sizing_duration: how long that motion is run [s].
+        measure_speed: measure steps per second of both models (the speed cost).
+        use_cache: read and write stored calibrations.
+    """
+
+    contact_mode: ContactMode = ContactMode.CALIBRATED
+    segments: int | None = None
+    journal_geom: GeomType = GeomType.SPHERE
+    segment_geom: GeomType = GeomType.SPHERE
+    timestep: float | None = None
+    ripple_limit: float = 0.02
+    impedance: float = 1e-3
+    control: SineControl = field(default_factory=SineControl)
+    sizing_duration: float = 1.0
+    measure_speed: bool = True
+    use_cache: bool = True
+
+    def __post_init__(self) -> None:
+        try:
+            mode = ContactMode(self.contact_mode)
+        except ValueError:
+            raise RetrofitError(f"contact_mode must be 'nominal' or 'calibrated' (got {self.contact_mode!r})") from None
+        if mode is ContactMode.EXACT:
+            raise RetrofitError(
+                "contact_mode 'exact' (the compiled exact contact) is not available for retrofits yet; "
+                "use 'calibrated' (the portable ring)"
+            )
+        object.__setattr__(self, "contact_mode", mode)
+        if self.segments is not None:
+            if not isinstance(self.segments, int) or isinstance(self.segments, bool) or self.segments < 8:
+                raise RetrofitError(f"segments must be an integer >= 8 (got {self.segments!r})")
+        for name in ("journal_geom", "segment_geom"):
+            try:
+                object.__setattr__(self, name, GeomType(getattr(self, name)))
+            except ValueError:
+                raise RetrofitError(
+                    f"{name} must be one of {[g.value for g in GeomType]} (got {getattr(self, name)!r})"
+                ) from None
+        if self.journal_geom is GeomType.BOX:
+            raise RetrofitError("journal_geom must be sphere, capsule or cylinder (got 'box')")
+        if self.timestep is not None:
+            h = positive("timestep", self.timestep, "s")
+            if h > 1e-2:
+                raise RetrofitError(f"timestep must be in (0, 0.01] s (got {self.timestep!r})")
+        if not 0 < finite("ripple_limit", self.ripple_limit) < 1:
+            raise RetrofitError(f"ripple_limit must be in (0, 1) (got {self.ripple_limit!r})")
+        if not 0 < finite("impedance", self.impedance) < 0.5:
+            raise RetrofitError(f"impedance must be in (0, 0.5) (got {self.impedance!r})")
+        if not isinstance(self.control, SineControl):
+            raise RetrofitError(f"control must be a SineControl (got {self.control!r})")
+        positive("sizing_duration", self.sizing_duration, "s")

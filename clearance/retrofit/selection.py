@@ -1,0 +1,180 @@
+"""Which hinges a retrofit edits, checked before any work.
+
+A hinge can be given radial play when it exists, is a hinge (not a ball, slide or free
+joint), is the only joint of its body, and the model lets contacts act (the bearing is a
+ring of contact pairs). A model that does not compile, or that already holds names with the
+retrofit's prefix, is refused too. Every refusal is one `RetrofitError` naming the joint and
+what was expected.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import mujoco
+
+from clearance.retrofit.play import DEFAULT_CLASS, PREFIX, RetrofitError
+
+__all__ = ["Hinge", "compile_model", "select_hinges", "hinge_names"]
+
+_OBJ = mujoco.mjtObj
+_JOINT_KIND = {
+    mujoco.mjtJoint.mjJNT_FREE: "a free joint",
+    mujoco.mjtJoint.mjJNT_BALL: "a ball joint",
+    mujoco.mjtJoint.mjJNT_SLIDE: "a slide joint",
+    mujoco.mjtJoint.mjJNT_HINGE: "a hinge",
+}
+_NAMED = (
+    _OBJ.mjOBJ_BODY,
+    _OBJ.mjOBJ_JOINT,
+    _OBJ.mjOBJ_GEOM,
+    _OBJ.mjOBJ_SITE,
+    _OBJ.mjOBJ_SENSOR,
+    _OBJ.mjOBJ_PAIR,
+    _OBJ.mjOBJ_ACTUATOR,
+    _OBJ.mjOBJ_EQUALITY,
+    _OBJ.mjOBJ_TENDON,
+    _OBJ.mjOBJ_KEY,
+)
+
+
+@dataclass(frozen=True)
+class Hinge:
+    """A hinge chosen for radial play, located in the compiled unmodified model.
+
+    Attributes:
+        name: the joint's name.
+        joint_id: its id in the unmodified model.
+        child_id: the body it moves (the journal's body).
+        parent_id: that body's parent in the compiled model (the bearing's body; 0 for the
+            world).
+    """
+
+    name: str
+    joint_id: int
+    child_id: int
+    parent_id: int
+
+
+def model_label(spec: mujoco.MjSpec) -> str:
+    """How messages name a model: its name, or 'the model'."""
+    return f"model '{spec.modelname}'" if spec.modelname else "the model"
+
+
+def compile_model(spec: mujoco.MjSpec) -> mujoco.MjModel:
+    """Compile ``spec``; a MuJoCo error becomes a `RetrofitError` carrying MuJoCo's message."""
+    try:
+        return spec.compile()
+    except ValueError as err:
+        raise RetrofitError(f"{model_label(spec)} does not compile in MuJoCo: {err}") from None
+
+
+def hinge_names(model: mujoco.MjModel) -> list[str]:
+    """Names of the model's named hinges, in joint order."""
+    out = []
+    for j in range(model.njnt):
+        name = mujoco.mj_id2name(model, _OBJ.mjOBJ_JOINT, j)
+        if name and model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
+            out.append(name)
+    return out
+
+
+def _prefixed_names(model: mujoco.MjModel) -> list[str]:
+    found = []
+    for objtype in _NAMED:
+        count = {
+            _OBJ.mjOBJ_BODY: model.nbody,
+            _OBJ.mjOBJ_JOINT: model.njnt,
+            _OBJ.mjOBJ_GEOM: model.ngeom,
+            _OBJ.mjOBJ_SITE: model.nsite,
+            _OBJ.mjOBJ_SENSOR: model.nsensor,
+            _OBJ.mjOBJ_PAIR: model.npair,
+            _OBJ.mjOBJ_ACTUATOR: model.nu,
+            _OBJ.mjOBJ_EQUALITY: model.neq,
+            _OBJ.mjOBJ_TENDON: model.ntendon,
+            _OBJ.mjOBJ_KEY: model.nkey,
+        }[objtype]
+        for i in range(count):
+            name = mujoco.mj_id2name(model, objtype, i)
+            if name and name.startswith(PREFIX):
+                found.append(name)
+    return found
+
+
+def select_hinges(spec: mujoco.MjSpec, model: mujoco.MjModel, names: Sequence[str]) -> list[Hinge]:
+    """Check the request and locate each hinge.
+
+    Args:
+        spec: the unmodified spec (for messages: its model name and default classes).
+        model: ``spec`` compiled.
+        names: the hinges to give play, in the user's order.
+
+    Returns:
+        One `Hinge` per name, in the order given.
+
+    Raises:
+        RetrofitError: no name, a name given twice, a joint that does not exist (the
+            message lists the hinges there are), a connect equality (loop closures are not
+            given play yet), a joint that is not a hinge, a hinge sharing its body with
+            other joints, contacts or constraints disabled, or names with the retrofit's
+            prefix already in the model.
+    """
+    label = model_label(spec)
+    if not names:
+        raise RetrofitError("name at least one hinge to give radial play")
+    seen: set[str] = set()
+    for n in names:
+        if n in seen:
+            raise RetrofitError(f"joint '{n}' is named twice")
+        seen.add(n)
+    flags = int(model.opt.disableflags)
+    for bit, what in (
+        (mujoco.mjtDisableBit.mjDSBL_CONSTRAINT, "constraint"),
+        (mujoco.mjtDisableBit.mjDSBL_CONTACT, "contact"),
+    ):
+        if flags & int(bit):
+            raise RetrofitError(
+                f'{label} disables {what}s (<option><flag {what}="disable"/>): the bearing ring is a set of '
+                "contact pairs and needs them; enable them to retrofit"
+            )
+    clash = _prefixed_names(model) + ([DEFAULT_CLASS] if spec.find_default(DEFAULT_CLASS) is not None else [])
+    if clash:
+        raise RetrofitError(
+            f"{label} already has names starting with '{PREFIX}' ({', '.join(sorted(clash)[:5])}), the prefix "
+            "of what a retrofit adds: is it retrofitted already? Retrofit the unmodified model"
+        )
+    hinges = hinge_names(model)
+    out = []
+    for n in names:
+        jid = mujoco.mj_name2id(model, _OBJ.mjOBJ_JOINT, n)
+        if jid < 0:
+            eq = mujoco.mj_name2id(model, _OBJ.mjOBJ_EQUALITY, n)
+            if eq >= 0 and model.eq_type[eq] == mujoco.mjtEq.mjEQ_CONNECT:
+                raise RetrofitError(
+                    f"'{n}' is a connect equality (a loop closure) of {label}: giving play to loop closures is not "
+                    "supported yet; name a hinge"
+                )
+            listed = ", ".join(hinges) if hinges else "none"
+            raise RetrofitError(f"joint '{n}' does not exist in {label}; its named hinges are: {listed}")
+        kind = mujoco.mjtJoint(int(model.jnt_type[jid]))
+        if kind != mujoco.mjtJoint.mjJNT_HINGE:
+            raise RetrofitError(
+                f"joint '{n}' is {_JOINT_KIND[kind]}: only a hinge can be given radial play "
+                f"(hinges of {label}: {', '.join(hinges) or 'none'})"
+            )
+        body = int(model.jnt_bodyid[jid])
+        if model.body_jntnum[body] != 1:
+            first = int(model.body_jntadr[body])
+            others = [
+                mujoco.mj_id2name(model, _OBJ.mjOBJ_JOINT, k) or f"#{k}"
+                for k in range(first, first + int(model.body_jntnum[body]))
+                if k != jid
+            ]
+            bname = mujoco.mj_id2name(model, _OBJ.mjOBJ_BODY, body) or f"#{body}"
+            raise RetrofitError(
+                f"hinge '{n}' shares body '{bname}' with other joints ({', '.join(others)}): radial play needs a "
+                "body whose only joint is the hinge"
+            )
+        out.append(Hinge(n, jid, body, int(model.body_parentid[body])))
+    return out
