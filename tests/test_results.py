@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import zipfile
+
 import numpy as np
+import pytest
 
 from clearance.results import JointResult, SimulationResult
 
@@ -30,10 +33,13 @@ def _result(n=50):
     )
 
 
-def test_round_trip_is_lossless(tmp_path):
+@pytest.mark.parametrize("compress", [False, True])
+def test_round_trip_is_lossless(tmp_path, compress):
     r = _result()
-    npz, js = r.save(tmp_path / "run")
+    npz, js = r.save(tmp_path / "run", compress=compress)
     assert npz.exists() and js.exists()
+    with zipfile.ZipFile(npz) as z:  # stored as they are by default (fast), deflated on request
+        assert {i.compress_type for i in z.infolist()} == {zipfile.ZIP_DEFLATED if compress else zipfile.ZIP_STORED}
     back = SimulationResult.load(tmp_path / "run.npz")
     assert np.array_equal(back.times, r.times)
     for k in r.outputs:

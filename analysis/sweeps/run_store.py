@@ -168,7 +168,7 @@ def _run_one(spec: RunSpec, store: str) -> str:
     try:
         res = simulate(mech, duration=spec.duration, options=spec.options)
         digest = digest_result(spec.name, res, start)
-        res.decimated(spec.keep_every).save(stem)
+        res.decimated(spec.keep_every).save(stem, compress=True)
     except Exception as err:
         digest = RunDigest(spec.name, "error", f"{type(err).__name__}: {err}", start)
     # the digest is written last: its presence marks a finished run
