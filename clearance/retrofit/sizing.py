@@ -233,11 +233,8 @@ def choose_time_step(sizings: Mapping[str, PlaySizing], model_step: float) -> fl
         return model_step
     target = STEP_OMEGA_H / omega
     exp = math.floor(math.log10(target))
-    best = 10.0**exp
-    for mant in (2.0, 5.0, 10.0):
-        if mant * 10.0**exp <= target * (1 + 1e-12):
-            best = mant * 10.0**exp
-    return min(best, model_step)
+    steps = [float(f"{mant}e{e}") for e in (exp - 1, exp, exp + 1) for mant in (1, 2, 5)]  # decimal values
+    return min(max(h for h in steps if h <= target * (1 + 1e-12)), model_step)
 
 
 def check_time_step(name: str, sizing: PlaySizing, h: float) -> None:
