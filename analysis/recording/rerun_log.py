@@ -17,6 +17,11 @@ which is why orbits are logged relative to the bearing centre in micrometres):
 * ``outputs/<output>/{displacement,velocity,acceleration}/{clearance,ideal}`` [SI: m or
   rad, per second, per second squared].
 * ``drives/<drive>/{speed,torque}`` [rad/s, N m].
+* ``reactions/<joint>/{magnitude,x,y}`` [N]: every joint's reaction, the force its link_a
+  exerts on its link_b in the world frame (`SimulationResult.joint_reactions`), and
+  ``reactions/<joint>/ideal`` the ideal twin's magnitude (when given);
+  ``mechanism/reactions``: the same forces as arrows from each joint (on link_b), scaled so
+  that the run's largest reaction is 40 % of the mechanism's size (the scale is in the label).
 * ``mechanism/links`` (line strips between each link's points), ``mechanism/joints`` and
   the static ``mechanism/ground`` [mm]. Only these are decimated to ``max_rate_hz`` rows
   per simulated second (a display rate); every other series is logged at full rate.
@@ -302,6 +307,25 @@ def log_run(
         scal(f"drives/{d}/speed", res.drive_speed[:, k], f"{tag}{d} speed [rad/s]")
         scal(f"drives/{d}/torque", res.drive_torque[:, k], f"{tag}{d} torque [N m]")
 
+    # joint reactions (world frame), the ideal twin's magnitude beside them
+    for jname, f in res.joint_reactions.items():
+        base = f"reactions/{jname}"
+        scal(f"{base}/magnitude", np.hypot(f[:, 0], f[:, 1]), f"{tag}{jname} reaction |F| [N]")
+        scal(f"{base}/x", f[:, 0], f"{tag}{jname} reaction Fx [N]")
+        scal(f"{base}/y", f[:, 1], f"{tag}{jname} reaction Fy [N]")
+        if run.ideal is not None and jname in run.ideal.joint_reactions:
+            fi = run.ideal.joint_reactions[jname]
+            path = run.path(f"{base}/ideal")
+            _scalars(
+                recording,
+                path,
+                _indexes(run.ideal.times, run.ideal.drive_angle),
+                np.hypot(fi[:, 0], fi[:, 1]),
+                f"{tag}{jname} reaction |F| ideal [N]",
+                _GREY,
+            )
+            logged.append(path)
+
     logged += _log_mechanism(recording, run, max_rate_hz)
     return logged
 
@@ -361,7 +385,52 @@ def _log_mechanism(recording: rr.RecordingStream, run: LoggedRun, max_rate_hz: f
         rr.Points2D(ground, colors=np.array([0x000000FF], np.uint32), radii=0.025 * size * _MM),
         static=True,
     )
-    return [links_path, joints_path, ground_path]
+    paths = [links_path, joints_path, ground_path]
+    if res.joint_reactions:
+        paths.append(_log_reaction_arrows(recording, run, rows, idx, pts, size))
+    return paths
+
+
+def _log_reaction_arrows(
+    recording: rr.RecordingStream,
+    run: LoggedRun,
+    rows: np.ndarray,
+    idx: list,
+    pts: dict[str, np.ndarray],
+    size: float,
+) -> str:
+    """Reaction arrows at the joints (on link_b's point) of the display rows; returns the path."""
+    res, mech = run.result, run.mechanism
+    names = [j for j in (jt.name for jt in mech.joints) if j in res.joint_reactions]
+    forces = np.stack([res.joint_reactions[j][rows] for j in names], axis=1)  # (r, k, 2) [N]
+    fmax = float(np.nanmax(np.hypot(forces[..., 0], forces[..., 1]), initial=0.0))
+    scale = 0.4 * size * _MM / fmax if fmax > 0 else 0.0  # mm per N
+    origins = np.stack(
+        [
+            pts[mech.joint(j).link_b][:, list(mech.link(mech.joint(j).link_b).points).index(mech.joint(j).point_b)]
+            for j in names
+        ],
+        axis=1,
+    )
+    path = run.path("mechanism/reactions")
+    n = len(rows)
+    recording.send_columns(
+        path,
+        indexes=idx,
+        columns=rr.Arrows2D.columns(
+            origins=(origins * _MM).reshape(-1, 2), vectors=np.nan_to_num(forces * scale).reshape(-1, 2)
+        ).partition([len(names)] * n),
+    )
+    recording.log(
+        path,
+        rr.Arrows2D.from_fields(
+            colors=np.array([0x2CA02CFF], np.uint32),
+            labels=[f"{j} (1 mm = {1 / scale:.3g} N)" if scale > 0 else j for j in names],
+            show_labels=False,
+        ),
+        static=True,
+    )
+    return path
 
 
 # -- blueprint ----------------------------------------------------------------------------
@@ -415,6 +484,14 @@ def make_blueprint(runs: Sequence[LoggedRun]) -> rrb.Blueprint:
                     name=f"{o} {kind}", origin="/", contents=[f"+ {r.path(f'outputs/{o}/{kind}')}/**" for r in runs]
                 )
             )
+    reactions = [
+        f"+ {r.path(f'reactions/{j}')}/{e}"
+        for r in runs
+        for j in r.result.joint_reactions
+        for e in ("magnitude", "ideal")
+    ]
+    if reactions:
+        series.append(rrb.TimeSeriesView(name="joint reactions [N]", origin="/", contents=reactions))
     speeds = [f"+ {r.path(f'drives/{d}')}/speed" for r in runs for d in _drive_names(r)]
     if speeds:
         series.append(rrb.TimeSeriesView(name="drive speed [rad/s]", origin="/", contents=speeds))
