@@ -1,24 +1,27 @@
 """Figures of the analyses: deviation, contact modes, phase portraits, Poincaré sections,
 bifurcation diagrams and criticality rankings.
 
-matplotlib only (Agg); the run figures (response, contact force, orbit) are in
-`clearance.analysis.figures.plots`. Every function returns the figure and, given a path, saves a
-PNG atomically (`plots.save_figure`).
+Drawn on Agg figures without pyplot (`canvas`); the run figures (response, contact force,
+orbit) are in `clearance.analysis.figures.plots`. Every function returns the figure and,
+given a path, saves a PNG atomically.
 """
 
 from __future__ import annotations
 
+import textwrap
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.figure import Figure
+from matplotlib import colormaps
+from matplotlib.axes import Axes
+from matplotlib.colors import BoundaryNorm, Colormap
+from matplotlib.figure import Figure, SubFigure
+from matplotlib.ticker import MaxNLocator
 
-from clearance.analysis.chaos.poincare import PhasePortrait, PoincareClassification
-from clearance.analysis.figures.plots import save_figure
+from clearance.analysis.chaos.poincare import PhasePortrait, PoincareClassification, section_warning
+from clearance.analysis.figures.canvas import envelope, new_figure, save_png, thin_path
+from clearance.analysis.figures.plots import MODE_COLOURS, save_figure
 from clearance.analysis.metrics.response import ContactMode, JointContactModes
 from clearance.analysis.metrics.statistics import DeviationStatistics, deviation_series
 from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
@@ -42,7 +45,6 @@ _PARAMS = {
     "speed": ("crank speed", "rpm", 30 / np.pi),
     "crank2_speed": ("crank 2 speed", "rad/s", 1.0),
 }
-_MODE_COLOURS = {ContactMode.IMPACT: "C3", ContactMode.CONTINUOUS: "C0"}
 
 
 def quantity_label(name: str) -> tuple[str, str, float]:
@@ -82,7 +84,7 @@ def plot_deviation(
     stats: DeviationStatistics,
     *,
     path: str | Path | None = None,
-) -> plt.Figure:
+) -> Figure:
     """Deviation from ideal over the statistics window, its 90 % band, and distributions.
 
     Args:
@@ -94,8 +96,10 @@ def plot_deviation(
     """
     t, y, y0 = deviation_series(result, ideal, output, skip=stats.window_start - result.times[0])
     label, unit, scale = quantity_label(output)
-    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4), gridspec_kw={"width_ratios": [2, 1]})
-    a1.plot(t * 1e3, (y - y0) * scale, lw=0.7, color="C3", label="deviation y - y_ideal")
+    fig = new_figure(11, 4)
+    gs = fig.add_gridspec(1, 2, width_ratios=[2, 1], left=0.08, right=0.98, top=0.86, bottom=0.14, wspace=0.22)
+    a1, a2 = fig.add_subplot(gs[0, 0]), fig.add_subplot(gs[0, 1])
+    a1.plot(*envelope(t * 1e3, (y - y0) * scale), lw=0.7, color="C3", label="deviation y - y_ideal")
     for v, lab in ((stats.band90, "90 % band ±"), (-stats.band90, None)):
         a1.axhline(v * scale, color="k", ls="--", lw=0.9, label=lab and f"{lab}{stats.band90 * scale:.3g} {unit}")
     a1.axhline(stats.mean_signed_deviation * scale, color="C2", lw=1.0, label="mean (signed)")
@@ -103,7 +107,7 @@ def plot_deviation(
     a1.set_ylabel(f"{label} deviation [{unit}]")
     a1.legend(loc="upper right", fontsize=8)
     a1.grid(alpha=0.3)
-    bins = np.linspace(min(y.min(), y0.min()), max(y.max(), y0.max()), 40) * scale
+    bins = (np.linspace(min(y.min(), y0.min()), max(y.max(), y0.max()), 40) * scale).tolist()
     a2.hist(y0 * scale, bins=bins, alpha=0.5, color="0.5", label="ideal")
     a2.hist(y * scale, bins=bins, alpha=0.5, color="C3", label="with clearance")
     a2.set_xlabel(f"{label} [{unit}]")
@@ -112,52 +116,115 @@ def plot_deviation(
     a2.set_title(f"KS = {stats.ks_statistic:.3g}, F = {stats.f_statistic:.4g}", fontsize=9)
     fig.suptitle(
         f"{output}: mean deviation {stats.mean_deviation * scale:.3g} {unit}, "
-        f"RMS {stats.rms_deviation * scale:.3g} {unit} (from t = {stats.window_start * 1e3:.3g} ms)"
+        f"RMS {stats.rms_deviation * scale:.3g} {unit} (window from t = {stats.window_start * 1e3:.3g} ms)",
+        fontsize=11,
     )
     if path is not None:
-        save_figure(fig, path)
+        save_png(fig, path)
     return fig
 
 
 def plot_contact_modes(
-    result: SimulationResult, modes: list[JointContactModes], *, path: str | Path | None = None
-) -> plt.Figure:
-    """Contact-force magnitude per joint with each contact event shaded by its mode.
+    windows: Mapping[str, Sequence[JointContactModes]], *, title: str = "", path: str | Path | None = None
+) -> Figure:
+    """Share of time in free flight, impact and continuous contact per joint and window (bars).
+
+    One horizontal stacked bar per joint and window (e.g. the start-up window and the steady
+    state), grouped by joint: the three modes' shares of the window's time, the share written
+    in each segment of 6 % or more, and the window's contact events beside the bar.
 
     Args:
-        result: the run.
-        modes: `JointContactModes` of the joints to show (one panel each).
+        windows: window label -> the joints' `JointContactModes` over that window.
+        title: figure title.
         path: PNG path to save to.
+
+    Returns:
+        The figure (one axes).
     """
-    fig, axes = plt.subplots(len(modes), 1, figsize=(9, 2.8 * len(modes)), sharex=True, squeeze=False)
-    for ax, m in zip(axes[:, 0], modes):
-        jr = result.joints[m.joint]
-        ax.plot(result.times * 1e3, jr.force_magnitude, color="k", lw=0.6, label="contact force")
-        seen = set()
-        for e in m.events:
-            lab = None if e.mode in seen else e.mode.value.replace("_", " ")
-            seen.add(e.mode)
-            ax.axvspan(
-                e.start * 1e3, (e.start + e.duration) * 1e3, color=_MODE_COLOURS[e.mode], alpha=0.25, lw=0, label=lab
-            )
-        fr = ", ".join(f"{k.value.replace('_', ' ')} {v:.0%}" for k, v in m.fractions.items())
-        ax.set_title(
-            f"{m.joint}: {fr}; impulse {m.impulse:.3g} N s; continuous if ≥ {m.continuous_after * 1e3:.3g} ms",
-            fontsize=9,
+    labels = list(windows)
+    joints = list(dict.fromkeys(m.joint for ms in windows.values() for m in ms))
+    by = {(w, m.joint): m for w, ms in windows.items() for m in ms}
+    rows = [(j, w) for j in joints for w in labels if (w, j) in by]
+    height = 1.55 + 0.42 * len(rows) + 0.25 * len(joints)
+    fig = new_figure(9.0, height)
+    ax = fig.add_axes((0.3, 0.8 / height, 0.52, 1 - 1.5 / height))
+    y = []
+    pos = 0.0
+    for k, (j, _) in enumerate(rows):
+        if k and rows[k - 1][0] != j:
+            pos += 0.6  # a gap between joints
+        y.append(pos)
+        pos += 1.0
+    y_arr = -np.asarray(y)
+    left = np.zeros(len(rows))
+    for mode in ContactMode:
+        share = np.array([by[(w, j)].fractions[mode] * 100 for j, w in rows])
+        ax.barh(
+            y_arr,
+            share,
+            left=left,
+            height=0.8,
+            color=MODE_COLOURS[mode],
+            alpha=1.0 if mode is ContactMode.FREE_FLIGHT else 0.75,
+            edgecolor="0.5",
+            lw=0.5,
+            label=mode.value.replace("_", " "),
         )
-        ax.set_ylabel("force [N]")
-        ax.legend(loc="upper right", fontsize=8)
-        ax.grid(alpha=0.3)
-    axes[-1, 0].set_xlabel("time [ms]")
+        for yy, lft, sh in zip(y_arr, left, share):
+            if sh >= 6:
+                colour = "k" if mode is ContactMode.FREE_FLIGHT else "white"
+                ax.text(lft + sh / 2, yy, f"{sh:.0f} %", ha="center", va="center", fontsize=8, color=colour)
+        left = left + share
+    for yy, (j, w) in zip(y_arr, rows):
+        m = by[(w, j)]
+        n_imp = sum(e.mode is ContactMode.IMPACT for e in m.events)
+        n_con = len(m.events) - n_imp
+        ax.text(101.5, yy, f"events: {n_imp} impact,\n{n_con} continuous", va="center", fontsize=7, color="0.3")
+    ax.set_yticks(y_arr, [f"{j}, {w}" for j, w in rows], fontsize=8)
+    ax.set_xlim(0, 100)
+    ax.set_xlabel("share of the window's time [%]")
+    ax.grid(alpha=0.3, axis="x")
+    ax.legend(loc="lower left", bbox_to_anchor=(0.0, 1.0), ncol=3, fontsize=8, frameon=False)
+    if title:
+        fig.suptitle(title, fontsize=10, x=0.02, ha="left", y=1 - 0.1 / height, va="top")
+    first = next(iter(by.values()), None)
+    if first is not None:
+        fig.text(
+            0.02,
+            0.08 / height,
+            f"continuous contact: a contact event of {first.continuous_after * 1e3:.3g} ms or longer "
+            "(5 % of the drive period); an event is counted in the window it starts in",
+            fontsize=7,
+            color="0.3",
+        )
     if path is not None:
-        save_figure(fig, path)
+        save_png(fig, path)
     return fig
+
+
+def _warn(ax: Axes, text: str) -> None:
+    """A caution written across the bottom of the axes (wrapped at 70 characters)."""
+    ax.text(
+        0.02,
+        0.02,
+        textwrap.fill(text, 70),
+        transform=ax.transAxes,
+        fontsize=7.5,
+        color="C3",
+        va="bottom",
+        ha="left",
+        bbox={"facecolor": "white", "edgecolor": "C3", "alpha": 0.85, "boxstyle": "round,pad=0.3"},
+        zorder=5,
+    )
 
 
 def plot_phase_portrait(
     portrait: PhasePortrait, *, section: np.ndarray | None = None, path: str | Path | None = None
-) -> plt.Figure:
+) -> Figure:
     """Phase portrait (quantity against its rate), with Poincaré points on top if given.
+
+    The path is thinned to about a pixel (`canvas.thin_path`). With fewer section points than
+    `chaos.poincare.MIN_SECTION_POINTS` the figure says so (`section_warning`).
 
     Args:
         portrait: `PhasePortrait` data.
@@ -168,20 +235,39 @@ def plot_phase_portrait(
     vlab, vunit, vscale = quantity_label(
         f"{portrait.name}_vel" if "." not in portrait.name else portrait.name.replace(".e", ".v")
     )
-    fig, ax = plt.subplots(figsize=(7, 5.5))
-    ax.plot(portrait.position * scale, portrait.velocity * vscale, lw=0.4, color="0.4", label="trajectory")
+    fig = new_figure(7, 5.5)
+    ax = fig.add_axes((0.13, 0.1, 0.83, 0.82))
+    x, v = portrait.position * scale, portrait.velocity * vscale
+    keep = thin_path(x, v)
+    ax.plot(x[keep], v[keep], lw=0.4, color="0.4", label="trajectory")
     if section is not None and len(section):
         ax.plot(
             section[:, 0] * scale, section[:, 1] * vscale, "o", ms=3.5, color="C3", label="Poincaré points (t = kT)"
         )
+    if section is not None:
+        warning = section_warning(len(section))
+        if warning:
+            _warn(ax, warning)
     ax.set_xlabel(f"{label} [{unit}]")
     ax.set_ylabel(f"{vlab} [{vunit}]")
-    ax.set_title(f"phase portrait of {portrait.name}")
+    ax.set_title(f"phase portrait of {portrait.name}", fontsize=11)
     ax.legend(loc="upper right", fontsize=8)
     ax.grid(alpha=0.3)
     if path is not None:
-        save_figure(fig, path)
+        save_png(fig, path)
     return fig
+
+
+def _period_colours(periods: np.ndarray) -> tuple[Colormap, BoundaryNorm, list[int]]:
+    """A discrete colour map with one colour per integer period, its norm and the integer ticks."""
+    lo, hi = int(periods.min()), int(periods.max())
+    bounds = np.arange(lo - 0.5, hi + 1.0, 1.0)
+    cmap = colormaps["viridis"].resampled(len(bounds) - 1)
+    if hi - lo < 12:
+        ticks = list(range(lo, hi + 1))
+    else:
+        ticks = [int(v) for v in MaxNLocator(nbins=10, integer=True).tick_values(lo, hi) if lo <= v <= hi]
+    return cmap, BoundaryNorm(bounds, cmap.N), ticks
 
 
 def plot_poincare(
@@ -190,39 +276,65 @@ def plot_poincare(
     classification: PoincareClassification | None = None,
     *,
     trajectory: np.ndarray | None = None,
+    periods: np.ndarray | None = None,
+    clearance: float | None = None,
     path: str | Path | None = None,
-    ax: plt.Axes | None = None,
+    ax: Axes | None = None,
     label: str | None = None,
-) -> plt.Figure:
-    """Poincaré section of two quantities, coloured by section index, with the regime.
+) -> Figure:
+    """Poincaré section of two quantities, coloured by drive period, with the regime.
+
+    Each point has the colour of its drive period k (t = kT), one colour per integer and an
+    integer colour bar. A joint's eccentricity section (``<joint>.ex``, ``<joint>.ey``) can
+    show its clearance circle. With fewer points than `chaos.poincare.MIN_SECTION_POINTS`
+    the figure says so (`section_warning`).
 
     Args:
         points: (K, 2) section points.
         names: the two quantity names (for labels and units).
         classification: regime to show in the title.
-        trajectory: (n, 2) full trajectory of the same quantities, drawn in grey behind.
+        trajectory: (n, 2) full trajectory of the same quantities, drawn in grey behind
+            (thinned to about a pixel).
+        periods: (K,) the drive period k of each point (t = kT); default 0 .. K - 1.
+        clearance: radial clearance c [m]: draws the circle of radius c about the bearing
+            centre (for an eccentricity section).
         path: PNG path to save to.
         ax: axes to draw into (a panel of a larger figure); default a new figure.
         label: text put before the title (e.g. the run's clearance).
     """
     (l1, u1, s1), (l2, u2, s2) = quantity_label(names[0]), quantity_label(names[1])
+    cax = None
     if ax is None:
-        fig, ax = plt.subplots(figsize=(6.5, 5.5))
+        fig: Figure | SubFigure = new_figure(6.6, 5.6)
+        ax = fig.add_axes((0.14, 0.1, 0.66, 0.8))
+        cax = fig.add_axes((0.84, 0.18, 0.03, 0.64))
     else:
-        parent = ax.figure
-        fig = parent if isinstance(parent, Figure) else parent.figure  # a SubFigure's root figure
-    if trajectory is not None:
-        ax.plot(trajectory[:, 0] * s1, trajectory[:, 1] * s2, lw=0.3, color="0.7", label="trajectory")
-    sc = ax.scatter(
-        points[:, 0] * s1,
-        points[:, 1] * s2,
-        c=np.arange(len(points)),
-        s=12,
-        cmap="viridis",
-        label="section points",
-        zorder=3,
-    )
-    fig.colorbar(sc, ax=ax, label="drive period index k")
+        fig = ax.figure
+    root = fig if isinstance(fig, Figure) else fig.figure  # a SubFigure's root figure
+    if trajectory is not None and len(trajectory):
+        keep = thin_path(trajectory[:, 0], trajectory[:, 1])
+        ax.plot(trajectory[keep, 0] * s1, trajectory[keep, 1] * s2, lw=0.3, color="0.7", label="trajectory")
+    if clearance is not None:
+        th = np.linspace(0, 2 * np.pi, 300)
+        ax.plot(
+            clearance * s1 * np.cos(th),
+            clearance * s2 * np.sin(th),
+            color="k",
+            lw=1.0,
+            label=f"clearance circle (c = {clearance * s1:.4g} {u1})",
+        )
+    ks = np.arange(len(points)) if periods is None else np.asarray(periods).astype(int)
+    if len(points):
+        cmap, norm, ticks = _period_colours(ks)
+        sc = ax.scatter(
+            points[:, 0] * s1, points[:, 1] * s2, c=ks, s=14, cmap=cmap, norm=norm, label="section points", zorder=3
+        )
+        cb = root.colorbar(sc, cax=cax) if cax is not None else root.colorbar(sc, ax=ax)
+        cb.set_ticks(ticks)
+        cb.set_label("drive period k (t = kT)")
+    warning = section_warning(len(points))
+    if warning:
+        _warn(ax, warning)
     if u1 == u2:
         ax.set_aspect("equal", adjustable="datalim")
     ax.set_xlabel(f"{l1} [{u1}]")
@@ -232,24 +344,24 @@ def plot_poincare(
     if classification is not None:
         c = classification
         title += f": {c.regime.value.replace('_', '-')}"
-        title += (
-            f" (period {c.period})"
-            if c.period
-            else f" (divergence {c.divergence:.2f}, D2 {c.correlation_dimension:.2f})"
-        )
+        if c.period:
+            title += f" (period {c.period})"
+        elif np.isfinite(c.divergence):
+            title += f" (divergence {c.divergence:.2f}, D2 {c.correlation_dimension:.2f})"
     ax.set_title(title, fontsize=10)
-    ax.legend(loc="upper right", fontsize=8)
+    ax.legend(loc="upper right", fontsize=7)
     ax.grid(alpha=0.3)
     if path is not None:
-        save_figure(fig, path)
-    return fig
+        save_png(root, path)
+    return root
 
 
-def plot_bifurcation(diagram: BifurcationDiagram, *, path: str | Path | None = None) -> plt.Figure:
+def plot_bifurcation(diagram: BifurcationDiagram, *, path: str | Path | None = None) -> Figure:
     """Bifurcation diagram: section samples against the parameter, coloured by regime."""
     pl, pu, ps = quantity_label(diagram.parameter)
     ql, qu, qs = quantity_label(diagram.quantity)
-    fig, ax = plt.subplots(figsize=(9, 5))
+    fig = new_figure(9, 5)
+    ax = fig.add_subplot()
     colours = {"periodic": "C0", "quasi_periodic": "C2", "chaotic": "C3", "undetermined": "0.5"}
     for reg, col in colours.items():
         sel = [i for i, r in enumerate(diagram.regimes) if r == reg]
@@ -271,14 +383,15 @@ def plot_bifurcation(diagram: BifurcationDiagram, *, path: str | Path | None = N
     return fig
 
 
-def plot_criticality(ranking: CriticalityRanking, *, path: str | Path | None = None) -> plt.Figure:
+def plot_criticality(ranking: CriticalityRanking, *, path: str | Path | None = None) -> Figure:
     """Bar chart of joint scores (mean deviation / clearance) with 95 % intervals.
 
     The axis unit follows the ranking's output kind (`CriticalityRanking.score_unit`): [-]
     for a position output, [rad/m] for an angle output.
     """
     s = ranking.scores
-    fig, ax = plt.subplots(figsize=(max(5, 1.4 * len(s) + 2), 4))
+    fig = new_figure(max(5, 1.4 * len(s) + 2), 4)
+    ax = fig.add_subplot()
     x = np.arange(len(s))
     err = np.array([[j.score - j.ci_low for j in s], [j.ci_high - j.score for j in s]])
     ax.bar(x, [j.score for j in s], yerr=err, capsize=4, color="C1", label="score, 95 % interval")

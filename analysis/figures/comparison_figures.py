@@ -2,9 +2,9 @@
 positions against the drive phase and Poincaré panels side by side, criticality rankings of
 related mechanisms.
 
-matplotlib only (Agg). Every function returns the figure and, given a path, saves a PNG
-atomically (`plots.save_figure`). Single-run figures are in `plots` and `figures`; the
-Poincaré panels reuse `figures.plot_poincare`.
+Drawn on Agg figures without pyplot (`canvas.new_figure`). Every function returns the figure
+and, given a path, saves a PNG atomically (`plots.save_figure`). Single-run figures are in
+`plots` and `analysis_figures`; the Poincaré panels reuse `analysis_figures.plot_poincare`.
 """
 
 from __future__ import annotations
@@ -13,15 +13,14 @@ from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import matplotlib
-
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.figure import Figure
 from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
 
 from clearance.analysis.chaos.poincare import PoincareClassification
 from clearance.analysis.figures.analysis_figures import plot_poincare, quantity_label
+from clearance.analysis.figures.canvas import new_figure
 from clearance.analysis.figures.plots import save_figure
 from clearance.analysis.sweeps.criticality import CriticalityRanking
 from clearance.results import SimulationResult
@@ -60,10 +59,11 @@ class TrendPanel:
 
 
 def _panel_row(
-    n: int, width: float, height: float, draw: Callable[[plt.Axes, int], None], title: str, path: str | Path | None
-) -> plt.Figure:
+    n: int, width: float, height: float, draw: Callable[[Axes, int], None], title: str, path: str | Path | None
+) -> Figure:
     """A row of ``n`` panels; ``draw(ax, k)`` fills panel k."""
-    fig, axes = plt.subplots(1, n, figsize=(width * n, height), squeeze=False)
+    fig = new_figure(width * n, height)
+    axes = fig.subplots(1, n, squeeze=False)
     for k, ax in enumerate(axes[0]):
         draw(ax, k)
     if title:
@@ -74,7 +74,7 @@ def _panel_row(
     return fig
 
 
-def plot_trends(panels: Sequence[TrendPanel], *, title: str = "", path: str | Path | None = None) -> plt.Figure:
+def plot_trends(panels: Sequence[TrendPanel], *, title: str = "", path: str | Path | None = None) -> Figure:
     """Panels side by side, each with one line (markers, optional error bars) per series.
 
     Args:
@@ -83,7 +83,7 @@ def plot_trends(panels: Sequence[TrendPanel], *, title: str = "", path: str | Pa
         path: PNG path to save to.
     """
 
-    def draw(ax: plt.Axes, i: int) -> None:
+    def draw(ax: Axes, i: int) -> None:
         p = panels[i]
         for k, (label, data) in enumerate(p.series.items()):
             x, y = np.asarray(data[0], float), np.asarray(data[1], float)
@@ -97,7 +97,7 @@ def plot_trends(panels: Sequence[TrendPanel], *, title: str = "", path: str | Pa
             ax.set_xticks(xs, [f"{v:g}" for v in xs])
             ax.xaxis.set_minor_formatter(NullFormatter())
             if len(xs) > 8:
-                plt.setp(ax.get_xticklabels(), rotation=45)
+                ax.tick_params(axis="x", labelrotation=45)
         if p.logy:
             ax.set_yscale("log")
             ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
@@ -121,7 +121,7 @@ def plot_output_overlay(
     relative: bool = False,
     title: str = "",
     path: str | Path | None = None,
-) -> plt.Figure:
+) -> Figure:
     """An output's displacement, velocity and acceleration for several runs, overlaid.
 
     The first run (typically the ideal mechanism) is drawn thick and grey behind the others.
@@ -135,7 +135,8 @@ def plot_output_overlay(
         title: figure title.
         path: PNG path to save to.
     """
-    fig, axes = plt.subplots(3, 1, figsize=(9.5, 8.5), sharex=True)
+    fig = new_figure(9.5, 8.5)
+    axes = fig.subplots(3, 1, sharex=True)
     first = next(iter(runs.values()))
     for ax, key, what in zip(
         axes, (output, f"{output}_vel", f"{output}_acc"), ("displacement", "velocity", "acceleration")
@@ -182,9 +183,7 @@ class OrbitPanel:
     period: float | None = None
 
 
-def plot_orbit_phase_panels(
-    panels: Sequence[OrbitPanel], *, title: str = "", path: str | Path | None = None
-) -> plt.Figure:
+def plot_orbit_phase_panels(panels: Sequence[OrbitPanel], *, title: str = "", path: str | Path | None = None) -> Figure:
     """Where the journal sits in its bearing against the drive phase, one colour per period.
 
     For each panel: the direction of the journal-centre eccentricity (bearing frame) [deg]
@@ -205,7 +204,7 @@ def plot_orbit_phase_panels(
     if len(periods) < len(panels):
         raise ValueError("every OrbitPanel needs a period > 0 s for plot_orbit_phase_panels")
 
-    def draw(ax: plt.Axes, k: int) -> None:
+    def draw(ax: Axes, k: int) -> None:
         p, period = panels[k], periods[k]
         r, jr = p.result, p.result.joints[p.joint]
         phase = np.mod(r.times, period) / period * 360.0
@@ -245,9 +244,7 @@ class PoincarePanel:
     label: str = ""
 
 
-def plot_poincare_panels(
-    panels: Sequence[PoincarePanel], *, title: str = "", path: str | Path | None = None
-) -> plt.Figure:
+def plot_poincare_panels(panels: Sequence[PoincarePanel], *, title: str = "", path: str | Path | None = None) -> Figure:
     """Poincaré sections side by side (`figures.plot_poincare` in each panel).
 
     Args:
@@ -256,7 +253,7 @@ def plot_poincare_panels(
         path: PNG path to save to.
     """
 
-    def draw(ax: plt.Axes, k: int) -> None:
+    def draw(ax: Axes, k: int) -> None:
         p = panels[k]
         plot_poincare(p.points, p.names, p.classification, trajectory=p.trajectory, ax=ax, label=p.label)
 
@@ -265,7 +262,7 @@ def plot_poincare_panels(
 
 def plot_ranking_comparison(
     rankings: Mapping[str, CriticalityRanking], *, title: str = "", path: str | Path | None = None
-) -> plt.Figure:
+) -> Figure:
     """Grouped bars: each ranking's joint scores relative to its top score, 95 % intervals.
 
     Joints are in the first ranking's order; a joint missing from a ranking has no bar.
@@ -279,7 +276,8 @@ def plot_ranking_comparison(
     joints = [s.joint for s in first.scores]
     n = len(rankings)
     width = 0.8 / n
-    fig, ax = plt.subplots(figsize=(max(6.0, 1.3 * len(joints) + 2), 4.3))
+    fig = new_figure(max(6.0, 1.3 * len(joints) + 2), 4.3)
+    ax = fig.add_subplot()
     x = np.arange(len(joints))
     for k, (label, r) in enumerate(rankings.items()):
         by = {s.joint: s for s in r.scores}

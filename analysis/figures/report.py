@@ -3,6 +3,12 @@
 `write_report` computes the analyses of this package on a result and its ideal twin,
 draws their figures next to the report and writes ``report.md`` (atomically) with the
 tables and relative image links.
+
+One start-up window serves every number and figure of the report: the first period of the
+slowest prescribed drive (``skip``, as ``clearance run`` passes `Mechanism.drive_period`).
+The report names it; start-up values (within it) and steady-state values (after it) are
+given side by side; a run no longer than the window says so instead of giving steady-state
+numbers.
 """
 
 from __future__ import annotations
@@ -11,33 +17,17 @@ from pathlib import Path
 
 import numpy as np
 
-from clearance.analysis.chaos.poincare import (
-    classify_poincare,
-    phase_portrait,
-    poincare_from_result,
-    quantity_series,
-)
 from clearance.analysis.figures import analysis_figures as figures
 from clearance.analysis.figures import plots
-from clearance.analysis.metrics.response import compare_response, contact_modes
+from clearance.analysis.figures.report_sections import Window, contact_section, poincare_section, section_points
+from clearance.analysis.metrics.lag import OutputLag, joint_lag
+from clearance.analysis.metrics.response import window_peaks
 from clearance.analysis.metrics.statistics import deviation_statistics, drive_period
 from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
 from clearance.analysis.sweeps.criticality import CriticalityRanking, ranking_markdown
 from clearance.results import ENERGY_TERMS, SimulationResult, atomic_write_text
 
-__all__ = ["write_report", "joint_sections", "energy_section"]
-
-
-def _clearance_of(result: SimulationResult, joint: str) -> float:
-    """Radial clearance c [m] from the samples: |e| - penetration = c at every sample."""
-    jr = result.joints[joint]
-    return float(np.median(np.hypot(jr.eccentricity[:, 0], jr.eccentricity[:, 1]) - jr.penetration))
-
-
-def _section(result: SimulationResult, names: list[str], period: float, skip: float) -> np.ndarray:
-    """(K, len(names)) Poincaré points at t = kT of the drive, from ``skip`` after the start on."""
-    ts, pts = poincare_from_result(result, names, period=period)
-    return pts[ts >= result.times[0] + skip]
+__all__ = ["write_report", "joint_sections", "energy_section", "lag_lines", "reactions_section", "startup_lines"]
 
 
 def joint_sections(result: SimulationResult, *, skip: float | None = None) -> dict[str, np.ndarray]:
@@ -45,7 +35,7 @@ def joint_sections(result: SimulationResult, *, skip: float | None = None) -> di
 
     Args:
         result: a run.
-        skip: start-up transient [s]; default one drive period.
+        skip: start-up window [s]; default one drive period.
 
     Returns:
         joint name -> (K, 2) journal-centre eccentricity [m] in the bearing frame, sampled at
@@ -53,11 +43,111 @@ def joint_sections(result: SimulationResult, *, skip: float | None = None) -> di
     """
     period = drive_period(result)
     skip = period if skip is None else skip
-    return {j: _section(result, [f"{j}.ex", f"{j}.ey"], period, skip) for j in result.joints}
+    return {j: section_points(result, [f"{j}.ex", f"{j}.ey"], period, skip)[1] for j in result.joints}
 
 
 def _g(v: float) -> str:
-    return f"{v:.4g}"
+    return "n/a" if not np.isfinite(v) else f"{v:.4g}"
+
+
+def startup_lines(window: Window) -> list[str]:
+    """The report's paragraph naming the start-up window and how it is defined.
+
+    Args:
+        window: the run's start-up window.
+
+    Returns:
+        Markdown lines.
+    """
+    if window.startup <= 0:
+        return [
+            "**No start-up window**: the mechanism has no prescribed drive period; every number below is of "
+            "the whole run.",
+            "",
+        ]
+    lines = [
+        f"**Start-up window**: {window.ms(window.start, window.split)}, the first period of the slowest "
+        "prescribed drive. The journal is released from the bearing centre and makes its first, largest "
+        "impacts in it. Start-up values are taken within it; steady-state values (peaks and peak ratios, "
+        "lag, deviation statistics, contact statistics, Poincaré sections) after it.",
+        "",
+    ]
+    if not window.has_steady_state:
+        lines += [
+            f"**No steady state**: the run ({window.ms(window.start, window.end)}) is no longer than its "
+            "start-up window; the values below are of the start-up alone. Run at least two drive periods "
+            "for steady-state numbers.",
+            "",
+        ]
+    return lines
+
+
+def _response_table(result: SimulationResult, ideal: SimulationResult, keys: list[str], window: Window) -> list[str]:
+    lines = [
+        "| quantity | window | min | at [ms] | max | at [ms] | ideal min | ideal max | peak ratio |",
+        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
+    if window.startup > 0:
+        parts = [("start-up", window.start, window.split), ("steady state", window.split, np.inf)]
+    else:
+        parts = [("whole run", window.start, np.inf)]
+    for key in keys:
+        for name, a, b in parts:
+            p = window_peaks(result, ideal, key, start=a, end=b)
+            if p is None:
+                lines.append(f"| {key} | {name} | n/a | | n/a | | n/a | n/a | n/a |")
+                continue
+            bold = "**" if name == "steady state" else ""
+            lines.append(
+                f"| {key} | {name} | {_g(p.min_value)} | {p.min_time * 1e3:.4g} | {_g(p.max_value)} | "
+                f"{p.max_time * 1e3:.4g} | {_g(p.ideal_min)} | {_g(p.ideal_max)} | {bold}{p.peak_ratio:.3g}{bold} |"
+            )
+    return lines
+
+
+def lag_lines(lag: OutputLag) -> list[str]:
+    """The report's paragraph on the output's lag behind the ideal output (`metrics.lag.joint_lag`).
+
+    Args:
+        lag: the estimate.
+
+    Returns:
+        Markdown lines.
+    """
+    head = (
+        f"**Lag** of {lag.output} behind the ideal output: one estimate from displacement, velocity and "
+        "acceleration together (least squares, each signal weighted by the inverse of its own misfit; "
+        "`clearance.analysis.metrics.lag`)"
+    )
+    if not np.isfinite(lag.lag):
+        return [f"{head}: not estimated, {lag.note}.", ""]
+    unc = f" ± {lag.uncertainty * 1e3:.2g} ms (standard error over the periods)" if np.isfinite(lag.uncertainty) else ""
+    per = ", ".join(f"{k} {v * 1e3:.3g} ms" for k, v in lag.per_signal.items())
+    verdict = "Resolved." if lag.resolved else f"**Not resolved**: {lag.note}."
+    return [
+        f"{head}, over the steady state's {lag.periods} whole drive period{'s' if lag.periods != 1 else ''} "
+        f"({lag.window[0] * 1e3:.4g}–{lag.window[1] * 1e3:.4g} ms), searched within ±{lag.bound * 1e3:.4g} ms "
+        f"(an eighth of the period) on a {lag.resolution * 1e3:.2g} ms grid: **{lag.lag * 1e3:.3g} ms**{unc}; "
+        f"positive means later than the ideal. Each signal alone: {per}. {verdict}",
+        "",
+    ]
+
+
+def reactions_section(result: SimulationResult, window: Window) -> list[str]:
+    """The report's "Joint reactions" section (the bearing load at every joint).
+
+    `write_report` calls it only for a result that carries joint reaction series
+    (``SimulationResult.joint_reactions``), after the contact section; the section's tables
+    and figures belong to the joint-reaction analysis and are not drawn here.
+
+    Args:
+        result: a run with joint reaction series.
+        window: its start-up window.
+
+    Returns:
+        The section's Markdown lines (none drawn here).
+    """
+    return []
 
 
 def energy_section(result: SimulationResult) -> list[str]:
@@ -99,6 +189,34 @@ def energy_section(result: SimulationResult) -> list[str]:
     return lines
 
 
+def _deviation_lines(
+    result: SimulationResult, ideal: SimulationResult, output: str, window: Window, out: Path
+) -> list[str]:
+    lines = ["## Deviation statistics", ""]
+    skip = window.startup if window.has_steady_state else 0.0
+    try:
+        st = deviation_statistics(result, ideal, output, skip=skip)
+    except ValueError as err:  # fewer than 3 samples in the window
+        return lines + [f"No deviation statistics: {err}.", ""]
+    figures.plot_deviation(result, ideal, output, st, path=out / "deviation.png")
+    lines += ["| statistic | value |", "|---|---:|"]
+    lines += [f"| {k} | {_g(v) if isinstance(v, float) else v} |" for k, v in st.as_dict().items()]
+    what = (
+        "the steady state (the start-up window skipped)"
+        if window.has_steady_state and window.startup > 0
+        else "the whole run (no steady state)"
+    )
+    lines += [
+        "",
+        f"Window from t = {st.window_start * 1e3:.4g} ms: {what}. Samples are autocorrelated: compare p-values "
+        "between runs, not as absolute levels.",
+        "",
+        "![deviation](deviation.png)",
+        "",
+    ]
+    return lines
+
+
 def write_report(
     out_dir: str | Path,
     result: SimulationResult,
@@ -117,7 +235,9 @@ def write_report(
         result: run with clearance.
         ideal: run of the ideal twin (same time step and drive).
         output: output analysed (default: the first position output).
-        skip: start-up transient [s] for statistics and sections; default one drive period.
+        skip: the start-up window [s]: the first period of the slowest prescribed drive
+            (`Mechanism.drive_period`; 0 for a mechanism without one); default one period of
+            the result's first drive.
         title: report title (default from the mechanism name).
         bifurcation: a diagram to include.
         ranking: a criticality ranking to include.
@@ -132,9 +252,10 @@ def write_report(
     out.mkdir(parents=True, exist_ok=True)
     positions = [k for k in result.outputs if not k.endswith(("_vel", "_acc"))]
     output = output or positions[0]
+    if output not in result.outputs:
+        raise KeyError(f"output {output!r} not in the result (have {positions})")
     period = drive_period(result)
-    skip = period if skip is None else skip
-    angular = "angle" in output
+    window = Window(float(result.times[0]), period if skip is None else skip, float(result.times[-1]))
     md = result.metadata
     lines = [f"# {title or md.get('mechanism', 'run')}: response with clearance", ""]
     lines += ["| item | value |", "|---|---|"]
@@ -155,111 +276,34 @@ def write_report(
     lines.append(
         f"| simulated time | {result.times[-1] * 1e3:.4g} ms ({result.times[-1] / period:.3g} drive periods) |"
     )
+    lines.append(f"| start-up window | {window.ms(window.start, window.split)} |")
     lines.append("")
+    lines += startup_lines(window)
 
     lines += ["## Response against the ideal mechanism", ""]
-    plots.plot_response(result, ideal, output, angular=angular, path=out / "response_vs_ideal.png")
+    angular = "angle" in output
+    plots.plot_response(
+        result, ideal, output, angular=angular, startup=window.startup, path=out / "response_vs_ideal.png"
+    )
     lines += ["![response](response_vs_ideal.png)", ""]
-    lines += [
-        "| quantity | lag [ms] | max | at [ms] | min | at [ms] | ideal max | ideal min | peak ratio |",
-        "|---|---:|---:|---:|---:|---:|---:|---:|---:|",
-    ]
-    for key in (output, f"{output}_vel", f"{output}_acc"):
-        if key not in result.outputs:
-            continue
-        c = compare_response(result, ideal, key, skip=skip)
-        p, p0 = c.peaks, c.ideal_peaks
-        lines.append(
-            f"| {key} | {c.lag * 1e3:.4g} | {_g(p.max_value)} | {p.max_time * 1e3:.4g} | {_g(p.min_value)} | "
-            f"{p.min_time * 1e3:.4g} | {_g(p0.max_value)} | {_g(p0.min_value)} | {c.peak_ratio:.3g} |"
-        )
+    keys = [k for k in (output, f"{output}_vel", f"{output}_acc") if k in result.outputs]
+    lines += _response_table(result, ideal, keys, window)
     lines += [
         "",
-        "Values in SI units (m, m/s, m/s² or rad, rad/s, rad/s²); lag > 0: the output is later "
-        "than the ideal one (cross-correlation peak).",
+        "Values in SI units (m, m/s, m/s² or rad, rad/s, rad/s²); peak ratio = max |y| / max |y_ideal| over the "
+        "same window. The figure is scaled to the steady state; triangles at an edge mark start-up samples "
+        "beyond it, shown at full scale beside.",
         "",
     ]
+    lines += lag_lines(joint_lag(result, ideal, output, startup=window.startup))
 
-    lines += ["## Deviation statistics", ""]
-    st = deviation_statistics(result, ideal, output, skip=skip)
-    figures.plot_deviation(result, ideal, output, st, path=out / "deviation.png")
-    lines += ["| statistic | value |", "|---|---:|"]
-    lines += [f"| {k} | {_g(v) if isinstance(v, float) else v} |" for k, v in st.as_dict().items()]
-    lines += [
-        "",
-        f"Window from t = {st.window_start * 1e3:.4g} ms (start-up transient skipped). Samples are "
-        "autocorrelated: compare p-values between runs, not as absolute levels.",
-        "",
-        "![deviation](deviation.png)",
-        "",
-    ]
-
+    lines += _deviation_lines(result, ideal, output, window, out)
     if result.joints:
-        lines += ["## Contact at the clearance joints", ""]
-        modes = [contact_modes(result, j) for j in result.joints]
-        plots.plot_contact_force(result, path=out / "contact_force.png")
-        figures.plot_contact_modes(result, modes, path=out / "contact_modes.png")
-        lines += [
-            "| joint | dominant mode | free flight | impact | continuous | events | impulse [N s] | peak force [N] "
-            "| p95 force [N] | impacts |",
-            "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|",
-        ]
-        for m in modes:
-            f = {k.value: v for k, v in m.fractions.items()}
-            lines.append(
-                f"| {m.joint} | {m.dominant.value} | {f['free_flight']:.1%} | {f['impact']:.1%} | "
-                f"{f['continuous_contact']:.1%} | {len(m.events)} | {m.impulse:.4g} | "
-                f"{m.summary.peak_force:.4g} | {m.summary.p95_force:.4g} | {m.summary.impacts} |"
-            )
-        thr = modes[0].continuous_after * 1e3
-        lines += [
-            "",
-            f"A contact event (penetration > 0 without a break) lasting at least {thr:.3g} ms (5 % of the "
-            "drive period) is continuous contact, a shorter one an impact.",
-            "",
-            "![contact force](contact_force.png)",
-            "",
-            "![contact modes](contact_modes.png)",
-            "",
-        ]
-        for j in result.joints:
-            plots.plot_orbit(result, j, _clearance_of(result, j), path=out / f"orbit_{j}.png")
-            lines += [f"![orbit {j}](orbit_{j}.png)", ""]
-
+        lines += contact_section(result, window, out)
+    if getattr(result, "joint_reactions", None):  # the joint reactions' section, where the result has them
+        lines += reactions_section(result, window)
     lines += energy_section(result)
-
-    lines += ["## Phase portraits and Poincaré sections", ""]
-    sections = [(output, f"{output}_vel")] + [(f"{j}.ex", f"{j}.ey") for j in result.joints]
-    lines += ["| section | points | regime | period | divergence | correlation dim. |", "|---|---:|---|---:|---:|---:|"]
-    # figures written by this call only: an earlier report in the same folder may have left others
-    phase_pngs, poincare_pngs = [], []
-    for k, names in enumerate(sections):
-        pts = _section(result, list(names), period, skip)
-        if len(pts) == 0:
-            continue
-        after = result.times >= result.times[0] + skip
-        vals = np.column_stack([quantity_series(result, n)[after] for n in names])
-        scale = float(np.sqrt(np.mean(np.sum((vals - vals.mean(axis=0)) ** 2, axis=1))))
-        cl = classify_poincare(pts, scale=scale)
-        lines.append(
-            f"| {names[0]} / {names[1]} | {cl.n_points} | {cl.regime.value} | {cl.period} | "
-            f"{cl.divergence:.3g} | {cl.correlation_dimension:.3g} |"
-        )
-        if names[1].endswith("_vel"):
-            figures.plot_phase_portrait(phase_portrait(result, names[0]), section=pts, path=out / f"phase_{k}.png")
-            phase_pngs.append((k, f"phase_{k}.png"))
-        else:
-            figures.plot_poincare(pts, names, cl, trajectory=vals, path=out / f"poincare_{k}.png")
-            poincare_pngs.append((k, f"poincare_{k}.png"))
-    lines += [
-        "",
-        "Regime criterion: `clearance.analysis.chaos.poincare` (distinct points within 1 % of the motion's RMS "
-        "size, then nearest-neighbour divergence of the section map). Few periods give few points: the "
-        "regime of a short run is indicative only.",
-        "",
-    ]
-    lines += [f"![section {k}]({name})" for k, name in phase_pngs + poincare_pngs]
-    lines.append("")
+    lines += poincare_section(result, output, window, period, out)
 
     if bifurcation is not None:
         figures.plot_bifurcation(bifurcation, path=out / "bifurcation.png")

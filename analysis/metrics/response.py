@@ -1,9 +1,12 @@
 """Response of a run with clearance against the ideal mechanism: lag, peaks, contact modes.
 
-Lag: the time shift that best aligns the output with the ideal output (peak of their
-cross-correlation, refined by a parabola through the three samples around it), or the
-phase of the drive-frequency Fourier component. Peaks: largest and smallest values and
-their times, overall and per drive period.
+Lag of one signal: the time shift that best aligns the output with the ideal output (peak
+of their cross-correlation, refined by a parabola through the three samples around it), or
+the phase of the drive-frequency Fourier component. The report uses the one lag of
+displacement, velocity and acceleration together (`clearance.analysis.metrics.lag`)
+instead: one signal's lag can disagree in sign with its derivatives'. Peaks: largest and
+smallest values and their times, overall, per drive period (`output_peaks`) and per window
+(`window_peaks`: the start-up apart from the steady state).
 
 Contact modes (the criterion, per contact event = a maximal run of samples with
 penetration > 0):
@@ -16,7 +19,8 @@ The default ``continuous_after`` is 5 % of the drive period (an 18 degree crank 
 Hertz impact of the benchmark lasts of order 0.1 ms, about 1 % of the 12 ms period at
 5000 rpm (REFERENCES.md section 3), while a journal that follows the bearing wall stays in
 contact for a sizeable part of the cycle. A joint's dominant mode is the mode with the
-largest share of the time after the start-up transient.
+largest share of the time in the window asked for (the whole run, the start-up window or
+the steady state).
 """
 
 from __future__ import annotations
@@ -37,11 +41,13 @@ __all__ = [
     "LagMethod",
     "OutputPeaks",
     "ResponseComparison",
+    "WindowPeaks",
     "compare_response",
     "contact_events",
     "contact_modes",
     "output_lag",
     "output_peaks",
+    "window_peaks",
 ]
 
 
@@ -103,6 +109,28 @@ class ResponseComparison:
 
 
 @dataclass(frozen=True)
+class WindowPeaks:
+    """Extremes of an output and of the ideal output over one window of a run (`window_peaks`).
+
+    Attributes:
+        window: (start, end) of the window [s].
+        max_value, max_time: largest value [output unit] and its time [s].
+        min_value, min_time: smallest value and its time.
+        ideal_max, ideal_min: the ideal output's extremes over the same window.
+        peak_ratio: max |y| / max |y_ideal| over the window [-] (inf when the ideal is 0).
+    """
+
+    window: tuple[float, float]
+    max_value: float
+    max_time: float
+    min_value: float
+    min_time: float
+    ideal_max: float
+    ideal_min: float
+    peak_ratio: float
+
+
+@dataclass(frozen=True)
 class ContactEvent:
     """One contact event (penetration > 0 without a break).
 
@@ -128,10 +156,10 @@ class JointContactModes:
 
     Attributes:
         joint: joint name.
-        dominant: mode with the largest time share after the transient.
-        fractions: mode -> share of the samples after the transient [-].
-        events: contact events after the transient.
-        impulse: total contact impulse after the transient [N s].
+        dominant: mode with the largest time share in the window.
+        fractions: mode -> share of the window's samples [-].
+        events: contact events starting in the window (classified over their whole duration).
+        impulse: total contact impulse in the window [N s].
         continuous_after: the duration threshold used [s].
         summary: the joint's contact statistics over the whole run (`JointSummary`).
     """
@@ -308,6 +336,53 @@ def compare_response(
     )
 
 
+def window_peaks(
+    result: SimulationResult, ideal: SimulationResult, output: str, *, start: float, end: float = float("inf")
+) -> WindowPeaks | None:
+    """Extremes of ``output`` and the ideal output over the samples with start <= t < end.
+
+    Use it to keep the start-up window's peaks apart from the steady state's: a journal
+    released from the bearing centre makes its largest impacts in the first drive period.
+
+    Args:
+        result: run with clearance.
+        ideal: run of the ideal twin (interpolated on the result's times).
+        output: output name.
+        start, end: the window [s] (times of the run).
+
+    Returns:
+        The `WindowPeaks`, or None when no sample lies in the window.
+
+    Raises:
+        KeyError: unknown output.
+    """
+    t = result.times
+    sel = (t >= start) & (t < end)
+    if not sel.any():
+        return None
+    tt, y = t[sel], result.outputs[output][sel]
+    y0 = np.interp(tt, ideal.times, ideal.outputs[output])
+    a, b = int(np.argmax(y)), int(np.argmin(y))
+    big0 = float(np.max(np.abs(y0)))
+    return WindowPeaks(
+        window=(float(tt[0]), float(tt[-1])),
+        max_value=float(y[a]),
+        max_time=float(tt[a]),
+        min_value=float(y[b]),
+        min_time=float(tt[b]),
+        ideal_max=float(y0.max()),
+        ideal_min=float(y0.min()),
+        peak_ratio=float(np.max(np.abs(y)) / big0) if big0 > 0 else float("inf"),
+    )
+
+
+def _event_bounds(penetration: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """First and last sample index of each contact event (maximal run of penetration > 0)."""
+    contact = np.asarray(penetration) > 0
+    edges = np.diff(np.concatenate([[0], contact.astype(np.int8), [0]]))
+    return np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0] - 1
+
+
 def contact_events(
     times: np.ndarray, penetration: np.ndarray, force: np.ndarray, *, continuous_after: float
 ) -> list[ContactEvent]:
@@ -319,21 +394,16 @@ def contact_events(
         force: (n,) contact-force magnitude [N].
         continuous_after: events at least this long are CONTINUOUS [s].
     """
-    contact = np.asarray(penetration) > 0
-    if not contact.any():
-        return []
     h = _sample_interval(times)
-    edges = np.diff(np.concatenate([[0], contact.astype(np.int8), [0]]))
-    starts, ends = np.nonzero(edges == 1)[0], np.nonzero(edges == -1)[0] - 1
     out = []
-    for a, b in zip(starts, ends):
-        seg_t, seg_f = times[a : b + 1], force[a : b + 1]
+    for a, b in zip(*_event_bounds(penetration)):
+        seg_f = force[a : b + 1]
         dur = float(times[b] - times[a] + h)
         # rectangle rule: each sample holds its force for one sample interval, so a
         # one-sample event still carries impulse
         imp = float(np.sum(seg_f) * h)
         mode = ContactMode.CONTINUOUS if dur >= continuous_after else ContactMode.IMPACT
-        out.append(ContactEvent(float(seg_t[0]), float(seg_t[-1]), dur, float(seg_f.max()), imp, mode))
+        out.append(ContactEvent(float(times[a]), float(times[b]), dur, float(seg_f.max()), imp, mode))
     return out
 
 
@@ -343,15 +413,22 @@ def contact_modes(
     *,
     continuous_after: float | None = None,
     skip: float | None = None,
+    end: float | None = None,
 ) -> JointContactModes:
     """Classify a clearance joint's contact as free flight, impacts or continuous contact.
+
+    Events are found and classified over the whole run (an event that crosses the window's
+    edge keeps the mode of its whole duration); the fractions, events and impulse are those
+    of the window from ``skip`` to ``end`` after the run's start.
 
     Args:
         result: a run.
         joint: clearance joint name.
         continuous_after: duration threshold [s]; default 5 % of the drive period.
-        skip: start-up transient excluded from the fractions [s]; default 0 (the first
-            impact is part of the behaviour).
+        skip: start of the window after the run's start [s]; default 0 (the first impact
+            is part of the behaviour).
+        end: end of the window after the run's start [s] (samples before it); default
+            the run's end.
 
     Raises:
         KeyError: unknown joint.
@@ -362,22 +439,31 @@ def contact_modes(
         continuous_after = 0.05 * drive_period(result)
     jr = result.joints[joint]
     t = result.times
-    keep = t >= t[0] + (skip or 0.0)
-    events = contact_events(t[keep], jr.penetration[keep], jr.force_magnitude[keep], continuous_after=continuous_after)
-    n = int(np.count_nonzero(keep))
     h = _sample_interval(t)
-    counts = {m: 0.0 for m in ContactMode}
-    for e in events:
-        counts[e.mode] += round(e.duration / h) if h > 0 else 1
-    counts[ContactMode.FREE_FLIGHT] = n - counts[ContactMode.IMPACT] - counts[ContactMode.CONTINUOUS]
+    keep = t >= t[0] + (skip or 0.0)
+    if end is not None:
+        keep &= t < t[0] + end
+    code = {ContactMode.FREE_FLIGHT: 0, ContactMode.IMPACT: 1, ContactMode.CONTINUOUS: 2}
+    label = np.zeros(len(t), dtype=np.int8)  # each sample's mode (code), from its whole event
+    events = []
+    for e, a, b in zip(
+        contact_events(t, jr.penetration, jr.force_magnitude, continuous_after=continuous_after),
+        *_event_bounds(jr.penetration),
+    ):
+        label[a : b + 1] = code[e.mode]
+        if keep[a]:
+            events.append(e)
+    n = int(np.count_nonzero(keep))
+    counts = {m: int(np.count_nonzero(label[keep] == i)) for m, i in code.items()}
     fractions = {m: (c / n if n else 0.0) for m, c in counts.items()}
     dominant = max(fractions, key=lambda m: fractions[m])
+    in_contact = keep & (label > 0)
     return JointContactModes(
         joint=joint,
         dominant=dominant,
         fractions=fractions,
         events=tuple(events),
-        impulse=float(sum(e.impulse for e in events)),
+        impulse=float(np.sum(jr.force_magnitude[in_contact]) * h),
         continuous_after=float(continuous_after),
         summary=joint_summary(result, joint),
     )

@@ -29,9 +29,9 @@ def write_outputs(
     result.save(out / "result")
     ideal.save(out / "ideal")
     period = mech.drive_period
-    # statistics skip the first drive period as start-up transient when the run is long enough;
-    # a mechanism driven by torques alone has no period: nothing is skipped
-    skip = period if period is not None and result.times[-1] > 2 * period else 0.0
+    # the start-up window (the first drive period) for every statistic, section and figure; the
+    # report says when a run is no longer; a mechanism driven by torques alone has none
+    skip = period or 0.0
     if getattr(args, "rerun", None):
         from clearance.analysis.figures.report import joint_sections
         from clearance.analysis.recording.rerun_log import record
