@@ -406,6 +406,7 @@ def _cli(argv: list[str], capsys) -> tuple[int, str, str]:
         (["--joint", "elbow:clearance_mm=nan"], "clearance_mm must be a finite number"),
         (["--joint", "elbow:clearance_mm=-0.1"], "clearance_mm must be > 0"),
         (["--joint", "elbow:stiffness=3"], "is not key=value with a key among"),
+        (["--joint", "elbow:eccentricity_x_mm=0.1"], "initial eccentricity (0.1, 0) mm must be smaller than"),
         (["--joint", "elbow", "--joint", "elbow"], "hinge 'elbow' is named twice"),
         (["--joint", "elbow", "--contact-mode", "exact"], "not available for retrofits yet"),
     ],

@@ -34,8 +34,11 @@ JOINT_KEYS = {
     "poisson_ratio": "--poisson-ratio",
     "restitution": "--restitution",
     "friction": "--friction",
+    "eccentricity_x_mm": "",
+    "eccentricity_y_mm": "",
 }
-"""Per-joint keys of ``--joint NAME:key=value,...`` -> the option they override."""
+"""Per-joint keys of ``--joint NAME:key=value,...`` -> the option they override ('': none; the
+journal's start in its bearing frame, [mm], defaults to the centre)."""
 
 
 def _in_range(name: str, low: float, high: float, *, low_open: bool, high_open: bool) -> Callable[[str], float]:
@@ -155,7 +158,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 def _joint_values(args: argparse.Namespace, text: str) -> tuple[str, dict[str, float]]:
     """(hinge name, its values in command-line units) from ``NAME[:key=value,...]``."""
-    values = {key: float(getattr(args, flag[2:].replace("-", "_"))) for key, flag in JOINT_KEYS.items()}
+    values = {
+        key: float(getattr(args, flag[2:].replace("-", "_"))) if flag else 0.0 for key, flag in JOINT_KEYS.items()
+    }
     name, sep, rest = text.partition(":")
     if not name:
         raise ValueError(f"--joint {text!r}: give the hinge's name first")
@@ -206,6 +211,12 @@ def plays_from_args(args: argparse.Namespace) -> dict[str, RadialPlay]:
                 f"{where}: the radial clearance {v['clearance_mm']:g} mm must be smaller than the bearing radius "
                 f"{v['bearing_radius_mm']:g} mm (--clearance-mm, --bearing-radius-mm)"
             )
+        ecc = math.hypot(v["eccentricity_x_mm"], v["eccentricity_y_mm"])
+        if ecc >= v["clearance_mm"]:
+            raise ValueError(
+                f"{where}: the initial eccentricity ({v['eccentricity_x_mm']:g}, {v['eccentricity_y_mm']:g}) mm must "
+                f"be smaller than the radial clearance {v['clearance_mm']:g} mm"
+            )
         material = Material(v["youngs_modulus_gpa"] * gpa, v["poisson_ratio"])
         clearance = Clearance(
             si(v["clearance_mm"], "mm"),
@@ -216,7 +227,8 @@ def plays_from_args(args: argparse.Namespace) -> dict[str, RadialPlay]:
             friction=v["friction"],
             law=ContactLaw(args.law),
         )
-        plays[name] = RadialPlay(clearance)
+        eccentricity = (si(v["eccentricity_x_mm"], "mm"), si(v["eccentricity_y_mm"], "mm"))
+        plays[name] = RadialPlay(clearance, eccentricity)
     return plays
 
 

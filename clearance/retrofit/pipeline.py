@@ -22,7 +22,7 @@ import numpy as np
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.spec import ring_geometry
 from clearance.model import Joint, JointType
-from clearance.options import GeomType, ModelOptions
+from clearance.options import ContactMode, GeomType, ModelOptions
 from clearance.retrofit.contact import PlayContact, play_contact, row_inverse_weight, write_pair_contact
 from clearance.retrofit.coordinates import CoordinateMap, check_map, coordinate_map, extend_keyframes
 from clearance.retrofit.elements import add_builtin_class
@@ -232,6 +232,11 @@ def retrofit(
         check_time_step(name, s, step)
 
     integrator = INTEGRATORS.get(mujoco.mjtIntegrator(int(twin.opt.integrator)), "implicitfast")
+    if options.contact_mode is ContactMode.CALIBRATED and integrator not in ("implicitfast", "euler"):
+        notes.append(
+            f"the model integrates with {integrator}; the ring's contact is fitted in the one-bearing impact scene, "
+            "which integrates with implicitfast (its explicit contact step is Euler's and implicitfast's alike)"
+        )
     done: dict[str, RetrofittedHinge] = {}
     for h in hinges:
         play, sizing = joints[h.name], sizings[h.name]

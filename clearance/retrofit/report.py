@@ -199,5 +199,6 @@ def retrofit_report(r: Retrofit, *, source: str = "", command: str = "", asset_c
     ]
     if r.notes:
         lines += ["## Notes", "", *[f"- {n}" for n in r.notes], ""]
-    lines += [f"MuJoCo {mujoco.__version__}; retrofit (spec edit, sizing, calibration, compiles) {r.wall_time:.2f} s."]
+    phases = ", ".join(f"{phase} {t:.2f} s" for phase, t in r.timings.items())
+    lines += [f"MuJoCo {mujoco.__version__}. Wall time: {phases}."]
     return "\n".join(lines) + "\n"
