@@ -2,10 +2,11 @@
 
 `plot_reactions` draws, per joint, the magnitude of its reaction force (the force its link_a
 exerts on its link_b) and, per drive, the magnitude of its torque, for the run and its ideal
-twin, on the steady-state scale with the start-up window shaded and shown at full scale
-beside. `reaction_section` writes the report's Markdown section: whole-run and steady-state
-peaks side by side, the per-cycle spread and the load factor against the ideal twin
-(`clearance.analysis.metrics.reactions`).
+twin, on the steady-state scale with the start-up window shaded, its excursions beyond that
+scale marked at the edge and the largest one written in the panel (one axes per series, no
+side panels: axes dominate a figure's drawing time). `reaction_section` writes the report's
+Markdown section: whole-run and steady-state peaks side by side, the per-cycle spread and the
+load factor against the ideal twin (`clearance.analysis.metrics.reactions`).
 """
 
 from __future__ import annotations
@@ -16,14 +17,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from clearance.analysis.figures.canvas import (
-    Trace,
-    draw_startup_panel,
-    draw_steady_scaled,
-    new_figure,
-    save_png,
-    traces_clipped,
-)
+from clearance.analysis.figures.canvas import Trace, draw_steady_scaled, envelope, new_figure, save_png
 from clearance.analysis.figures.plots import force_unit
 from clearance.analysis.metrics.reactions import ReactionSummary, reaction_magnitudes, summarise_reactions
 from clearance.results import SimulationResult
@@ -47,6 +41,7 @@ def plot_reactions(
         result: a run with joint reactions.
         ideal: its ideal twin's run (drawn in grey), or None.
         startup: start-up window from the run's start [s] (0: none; the scale is the whole run's).
+            The largest start-up excursion beyond the steady-state scale is written in its panel.
         path: PNG path to save to.
 
     Returns:
@@ -79,44 +74,45 @@ def plot_reactions(
         rows.append(traces)
     ncols = 1 if len(names) <= _MAX_ROWS else 2
     nrows = math.ceil(len(names) / ncols)
-    clipped = [startup > 0 and traces_clipped(tr, window[1]) for tr in rows]
-    panel = any(clipped)
-    fig = new_figure(9.5 if ncols == 1 else 15.0, 1.2 + 1.9 * nrows)
+    fig = new_figure(9.0 if ncols == 1 else 14.0, 1.0 + 1.55 * nrows)
     h = fig.get_figheight()
     gs = fig.add_gridspec(
         nrows,
-        2 * ncols if panel else ncols,
-        width_ratios=[4.3, 1] * ncols if panel else None,
-        left=0.08 if ncols == 1 else 0.06,
+        ncols,
+        left=0.09 if ncols == 1 else 0.06,
         right=0.98,
-        top=1 - 0.8 / h,
-        bottom=0.55 / h,
-        hspace=0.35,
-        wspace=0.3,
+        top=1 - 0.7 / h,
+        bottom=0.5 / h,
+        hspace=0.38,
+        wspace=0.22,
     )
     first = None
     for i, (name, traces, unit) in enumerate(zip(names, rows, units)):
         r, c = i % nrows, i // nrows
-        col = 2 * c if panel else c
-        ax = fig.add_subplot(gs[r, col], sharex=first)
+        ax = fig.add_subplot(gs[r, c], sharex=first)
         first = first or ax
         if startup > 0:
-            lim, _ = draw_steady_scaled(ax, traces, window, label="start-up" if r == 0 else None)
-            if clipped[i] and lim is not None:
-                side = fig.add_subplot(gs[r, col + 1])
-                draw_startup_panel(side, traces, window, lim)
-                if r > 0:
-                    side.set_title("")  # the first row's title names the panels of the column
+            lim, clipped = draw_steady_scaled(ax, traces, window, label="start-up" if r == 0 else None)
+            if clipped:
+                worst = max(clipped, key=lambda k: abs(k.peak))
+                value = f"{worst.peak:.0f}" if abs(worst.peak) >= 1e3 else f"{worst.peak:.3g}"
+                ax.set_title(
+                    f"start-up peak {value} {unit} at {worst.peak_time:.3g} ms (off this scale)",
+                    loc="left",
+                    fontsize=7,
+                    pad=2,
+                    color="0.3",
+                )
         else:
             for tr in traces:
-                ax.plot(tr.x, tr.y, **tr.style)
+                ax.plot(*envelope(tr.x, tr.y), **tr.style)
         ax.set_label(name)
         kind = "torque" if name not in result.joint_reactions else "|F|"
         ax.set_ylabel(f"{name} {kind} [{unit}]", fontsize=8)
         ax.tick_params(labelsize=8)
         ax.grid(alpha=0.3)
         if r == nrows - 1 or i == len(names) - 1:
-            ax.set_xlabel("time [ms]")
+            ax.set_xlabel("time [ms]", fontsize=9)
         else:
             ax.tick_params(labelbottom=False)
         if i == 0:
