@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from clearance.contact_calibration.fit import GOALS
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.spec import ring_geometry
 from clearance.model import Joint, JointType
@@ -253,6 +254,7 @@ def retrofit(
         ring = _ring(play, sizing.segments, model_options)
         with clock("contact parameters"):
             contact = play_contact(play.clearance, ring, sizing, model_options, use_cache=options.use_cache)
+        notes += _accuracy_notes(h.name, contact, ring, sizing)
         with clock("spec edit and compiles"):
             added = add_bearing(
                 work,
@@ -282,6 +284,24 @@ def retrofit(
     return Retrofit(
         work, model, twin_spec, twin, done, options, integrator, step, cmap, motion, nkeys, speed, notes, clock.times
     )
+
+
+def _accuracy_notes(name: str, contact: PlayContact, ring: RingGeometry, sizing: PlaySizing) -> list[str]:
+    """A note when the calibrated ring misses the fit's accuracy goals at some impact speed."""
+    cal = contact.calibration
+    if cal is None:
+        return []
+    missed = [row for row in cal.rows if not row.meets_goals()]
+    if not missed:
+        return []
+    force = max((row.peak_force_worst for row in cal.rows), key=abs)
+    rest = max((row.restitution_worst for row in cal.rows), key=abs)
+    return [
+        f"hinge '{name}': the calibrated ring misses the fit's accuracy goals at {len(missed)} of {len(cal.rows)} "
+        f"impact speeds (worst peak force {force:+.1%}, restitution {rest:+.3f}; goals "
+        f"{GOALS['peak_force']:.0%} and {GOALS['restitution']:g}); the ring's polygon error c (pi/N)^2 / 2 is "
+        f"{ring.polygon_error * 1e6:.3g} um against a typical penetration of {sizing.typical_penetration * 1e6:.3g} um"
+    ]
 
 
 class _Clock:
