@@ -446,7 +446,8 @@ def section_warning(n_points: int, *, min_points: int = MIN_SECTION_POINTS) -> s
     """
     if n_points >= min_points:
         return None
+    count = "no section point" if n_points == 0 else f"only {n_points} section point{'s' if n_points != 1 else ''}"
     return (
-        f"only {n_points} section point{'s' if n_points != 1 else ''} (fewer than {min_points}): too few drive "
-        f"periods to tell the regime; a run of {min_points + 1} drive periods or more gives {min_points}"
+        f"{count} (fewer than {min_points}): too few drive periods to tell the regime; a run of "
+        f"{min_points + 1} drive periods or more gives {min_points}"
     )

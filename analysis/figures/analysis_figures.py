@@ -332,6 +332,8 @@ def plot_poincare(
         cb = root.colorbar(sc, cax=cax) if cax is not None else root.colorbar(sc, ax=ax)
         cb.set_ticks(ticks)
         cb.set_label("drive period k (t = kT)")
+    elif cax is not None:
+        cax.set_visible(False)  # no point: no colour bar
     warning = section_warning(len(points))
     if warning:
         _warn(ax, warning)

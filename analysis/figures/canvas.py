@@ -251,31 +251,39 @@ class Trace:
     marks_clipping: bool = True
 
 
-def _limits_of(traces: list[Trace], steady_from: float) -> tuple[float, float] | None:
+def _limits_of(traces: list[Trace], steady_from: float, include_zero: bool) -> tuple[float, float] | None:
     lims = [steady_limits(tr.x, [tr.y], steady_from, pad=0.0) for tr in traces]
     got = [lim for lim in lims if lim is not None]
     if not got:
         return None
     lo, hi = min(lim[0] for lim in got), max(lim[1] for lim in got)
+    if include_zero:
+        lo, hi = min(lo, 0.0), max(hi, 0.0)
     margin = 0.06 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.06
     return lo - margin, hi + margin
 
 
-def traces_clipped(traces: list[Trace], steady_from: float) -> bool:
+def traces_clipped(traces: list[Trace], steady_from: float, *, include_zero: bool = False) -> bool:
     """Whether a clipping-marked trace leaves the steady-state limits of ``traces`` (`draw_steady_scaled`).
 
     Args:
         traces: the traces of one axes.
         steady_from: start of the steady state on their abscissa.
+        include_zero: the limits reach down (or up) to 0 (a magnitude).
     """
-    lim = _limits_of(traces, steady_from)
+    lim = _limits_of(traces, steady_from, include_zero)
     if lim is None:
         return False
     return any(tr.marks_clipping and bool(np.any((tr.y < lim[0]) | (tr.y > lim[1]))) for tr in traces)
 
 
 def draw_steady_scaled(
-    ax: Axes, traces: list[Trace], startup: tuple[float, float], *, label: str | None = "start-up"
+    ax: Axes,
+    traces: list[Trace],
+    startup: tuple[float, float],
+    *,
+    label: str | None = "start-up",
+    include_zero: bool = False,
 ) -> tuple[tuple[float, float] | None, list[Clipped]]:
     """Draw traces (thinned by `envelope`) with y-limits from the steady state and the start-up marked.
 
@@ -288,6 +296,7 @@ def draw_steady_scaled(
         traces: the series, drawn in order.
         startup: (start, end) of the start-up window on x.
         label: text of the window (None: none).
+        include_zero: the limits reach down (or up) to 0 (a magnitude).
 
     Returns:
         The limits set (None: automatic) and the excursions beyond them, one per marked trace
@@ -296,7 +305,7 @@ def draw_steady_scaled(
     for tr in traces:
         ax.plot(*envelope(tr.x, tr.y), **tr.style)
     mark_startup(ax, *startup, label=label)
-    lim = _limits_of(traces, startup[1])
+    lim = _limits_of(traces, startup[1], include_zero)
     clipped: list[Clipped] = []
     if lim is not None:
         ax.set_ylim(*lim)

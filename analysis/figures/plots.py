@@ -74,12 +74,13 @@ def _steady_rows(
     left: float,
     top: float,
     bottom: float,
+    include_zero: bool = False,
 ) -> list[tuple[Axes, list[Trace]]]:
     """Axes for rows of traces sharing time: a start-up panel beside each row that needs one.
 
     Returns (main axes, traces) per row, drawn; the panels are drawn too.
     """
-    clipped = [traces_clipped(tr, window[1]) for tr in rows]
+    clipped = [traces_clipped(tr, window[1], include_zero=include_zero) for tr in rows]
     panel = any(clipped)
     gs = fig.add_gridspec(
         len(rows),
@@ -97,7 +98,7 @@ def _steady_rows(
     for i, traces in enumerate(rows):
         ax = fig.add_subplot(gs[i, 0], sharex=first)
         first = first or ax
-        lim, _ = draw_steady_scaled(ax, traces, window, label="start-up" if i == 0 else None)
+        lim, _ = draw_steady_scaled(ax, traces, window, label="start-up" if i == 0 else None, include_zero=include_zero)
         if clipped[i] and lim is not None:
             draw_startup_panel(fig.add_subplot(gs[i, 1]), traces, window, lim)
         if i < len(rows) - 1:
@@ -208,7 +209,7 @@ def plot_contact_force(
         rows.append([Trace(t_ms, f * scale, {"color": "k", "lw": 0.6, "label": "contact force"})])
     fig = new_figure(9.5, 1.3 + 2.6 * max(1, len(joints)))
     h = fig.get_figheight()
-    drawn = _steady_rows(fig, rows, window, left=0.09, top=1 - 1.0 / h, bottom=0.55 / h)
+    drawn = _steady_rows(fig, rows, window, left=0.09, top=1 - 1.0 / h, bottom=0.55 / h, include_zero=True)
     for (ax, _), j, unit in zip(drawn, joints, units):
         ax.set_label(j)
         m = by_joint[j]

@@ -120,7 +120,7 @@ def lag_lines(lag: OutputLag) -> list[str]:
         "`clearance.analysis.metrics.lag`)"
     )
     if not np.isfinite(lag.lag):
-        return [f"{head}: not estimated, {lag.note}.", ""]
+        return [f"{head}: not estimated: {lag.note}.", ""]
     unc = f" ± {lag.uncertainty * 1e3:.2g} ms (standard error over the periods)" if np.isfinite(lag.uncertainty) else ""
     per = ", ".join(f"{k} {v * 1e3:.3g} ms" for k, v in lag.per_signal.items())
     verdict = "Resolved." if lag.resolved else f"**Not resolved**: {lag.note}."

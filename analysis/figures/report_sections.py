@@ -235,19 +235,23 @@ def poincare_section(result: SimulationResult, output: str, window: Window, peri
     # figures written by this call only: an earlier report in the same folder may have left others
     pngs: list[tuple[int, str]] = []
     warnings: list[str] = []
-    after = result.times >= window.split
+    # the trajectory drawn behind a section: the steady state's, or the whole run's when it has none
+    after = result.times >= (window.split if window.has_steady_state else window.start)
     for k, names in enumerate(sections):
         ks, pts = section_points(result, list(names), period, window.startup)
-        if len(pts) == 0:
-            warnings.append(f"{names[0]} / {names[1]}: no section point after the start-up window")
-            continue
         vals = np.column_stack([quantity_series(result, n)[after] for n in names])
-        scale = float(np.sqrt(np.mean(np.sum((vals - vals.mean(axis=0)) ** 2, axis=1))))
-        cl = classify_poincare(pts, scale=scale)
+        cl = None
+        if len(pts):
+            scale = float(np.sqrt(np.mean(np.sum((vals - vals.mean(axis=0)) ** 2, axis=1))))
+            cl = classify_poincare(pts, scale=scale)
         flag = " (too few)" if len(pts) < MIN_SECTION_POINTS else ""
         lines.append(
-            f"| {names[0]} / {names[1]} | {cl.n_points}{flag} | {cl.regime.value} | {cl.period} | "
-            f"{cl.divergence:.3g} | {cl.correlation_dimension:.3g} |"
+            f"| {names[0]} / {names[1]} | {len(pts)}{flag} | "
+            + (
+                f"{cl.regime.value} | {cl.period} | {cl.divergence:.3g} | {cl.correlation_dimension:.3g} |"
+                if cl is not None
+                else "n/a | | | |"
+            )
         )
         warning = section_warning(len(pts))
         if warning:

@@ -22,7 +22,8 @@ estimate (`joint_lag`):
    periods or more); resolution: the sample interval before refinement.
 5. Each signal's own lag (the minimum of its M_s) is kept beside, to show whether the three
    agree. The lag is ``resolved`` when it lies inside the bound, the three signals agree in
-   sign with it, and (with two periods or more) it is more than twice its uncertainty.
+   sign with it, it is at least `RESOLUTION_FLOOR` of the sample interval and (with two
+   periods or more) more than twice its uncertainty.
 
 The earlier per-signal cross-correlation (`response.output_lag`) searched a window cut by
 the search range and disagreed in sign between the three signals of one run (the press at
@@ -38,10 +39,15 @@ import numpy as np
 from clearance.analysis.metrics.statistics import drive_period
 from clearance.results import SimulationResult
 
-__all__ = ["DEFAULT_BOUND_FRACTION", "OutputLag", "joint_lag"]
+__all__ = ["DEFAULT_BOUND_FRACTION", "RESOLUTION_FLOOR", "OutputLag", "joint_lag"]
 
 DEFAULT_BOUND_FRACTION = 0.125
 """Lags searched up to this fraction of the drive period either way (45 degrees of the drive)."""
+
+RESOLUTION_FLOOR = 0.01
+"""A lag smaller than this fraction of the sample interval is no lag: the parabolic refinement
+finds a whole-sample shift of a smooth signal to about 0.2 % of the interval (tests), so a
+hundredth leaves a margin of five."""
 
 
 @dataclass(frozen=True)
@@ -58,8 +64,9 @@ class OutputLag:
         periods: whole drive periods in the window.
         window: (start, end) of the window [s].
         per_signal: signal name -> its own lag [s] (NaN where not estimated).
-        resolved: the lag is inside the bound, the signals agree in sign with it, and it is
-            more than twice its uncertainty (when there is one).
+        resolved: the lag is inside the bound, the signals agree in sign with it, it is at
+            least `RESOLUTION_FLOOR` of the sample interval and more than twice its
+            uncertainty (when there is one).
         note: why there is no estimate or why it is not resolved ("" when resolved).
     """
 
@@ -184,7 +191,7 @@ def joint_lag(
             0,
             (start, float(t[-1])),
             blank,
-            note="no whole drive period after the start-up window: no lag estimated",
+            note="the run has no whole drive period after its start-up window",
         )
     per = int(round(period / h))
     i0 = int(np.searchsorted(t, start - 0.5 * h))
@@ -212,6 +219,8 @@ def joint_lag(
         notes.append("the signals disagree in sign")
     if np.isfinite(uncertainty) and not abs(lag) > 2 * uncertainty:
         notes.append("the lag is within twice its uncertainty of zero")
+    if not abs(lag) >= RESOLUTION_FLOOR * h:
+        notes.append(f"the lag is below {RESOLUTION_FLOOR:.0%} of the sample interval: no lag")
     return OutputLag(
         output,
         float(lag),
