@@ -106,10 +106,12 @@ def plot_deviation(
     a1.set_xlabel("time [ms]")
     a1.set_ylabel(f"{label} deviation [{unit}]")
     a1.legend(loc="upper right", fontsize=8)
+    a1.locator_params(axis="y", nbins=6)
     a1.grid(alpha=0.3)
-    bins = (np.linspace(min(y.min(), y0.min()), max(y.max(), y0.max()), 40) * scale).tolist()
-    a2.hist(y0 * scale, bins=bins, alpha=0.5, color="0.5", label="ideal")
-    a2.hist(y * scale, bins=bins, alpha=0.5, color="C3", label="with clearance")
+    bins = np.linspace(min(y.min(), y0.min()), max(y.max(), y0.max()), 40) * scale
+    for values, colour, name in ((y0, "0.5", "ideal"), (y, "C3", "with clearance")):
+        counts, _ = np.histogram(values * scale, bins=bins)
+        a2.stairs(counts, bins, fill=True, alpha=0.5, color=colour, label=name)  # one artist, not 40 bars
     a2.set_xlabel(f"{label} [{unit}]")
     a2.set_ylabel("samples")
     a2.legend(fontsize=8)

@@ -119,7 +119,7 @@ def envelope(x: np.ndarray, y: np.ndarray, *, columns: int = _ENVELOPE_COLUMNS) 
     return x[keep], y[keep]
 
 
-def thin_path(x: np.ndarray, y: np.ndarray, *, resolution: float = 1.0 / 1500) -> np.ndarray:
+def thin_path(x: np.ndarray, y: np.ndarray, *, resolution: float = 1.0 / 600) -> np.ndarray:
     """Indices of a planar path, one point every ``resolution`` of its extent along the path.
 
     Distances are measured with each coordinate divided by its range, so a step is a fixed
@@ -304,6 +304,7 @@ def draw_steady_scaled(
     """
     for tr in traces:
         ax.plot(*envelope(tr.x, tr.y), **tr.style)
+    ax.locator_params(axis="y", nbins=5)  # fewer ticks: each costs a few ms to draw
     mark_startup(ax, *startup, label=label)
     lim = _limits_of(traces, startup[1], include_zero)
     clipped: list[Clipped] = []
@@ -335,6 +336,7 @@ def draw_startup_panel(
     for v in limits:
         ax.axhline(v, color="0.3", lw=0.8, ls="--")
     ax.set_xlim(*startup)
+    ax.locator_params(nbins=4)
     ax.set_facecolor("0.96")
     ax.tick_params(labelsize=7)
     ax.set_title("start-up, full scale\n(dashes: steady-state scale)", fontsize=8)

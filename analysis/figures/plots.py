@@ -15,10 +15,13 @@ from collections.abc import Sequence
 from pathlib import Path
 
 import numpy as np
+from matplotlib import colormaps
 from matplotlib.axes import Axes
-from matplotlib.collections import LineCollection
+from matplotlib.cm import ScalarMappable
+from matplotlib.colors import BoundaryNorm
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
+from matplotlib.ticker import FormatStrFormatter
 
 from clearance.analysis.figures.canvas import (
     Trace,
@@ -241,8 +244,10 @@ def plot_orbit(
 ) -> Figure:
     """Journal-centre orbit in the bearing frame inside the clearance circle (µm).
 
-    The start-up window's part is a thin grey line, the steady state a line coloured by
-    time; the path is thinned to about a pixel (`canvas.thin_path`).
+    The start-up window's part is a thin grey line; the steady state is cut into 12 equal
+    spans of time, each a line of its own colour (a stepped colour bar of time), which draws
+    far faster than a colour per sample; the path is thinned to about a pixel
+    (`canvas.thin_path`).
 
     Args:
         result: the run.
@@ -256,24 +261,30 @@ def plot_orbit(
     c = clearance * 1e6
     t_ms = result.times * 1e3
     keep = thin_path(e[:, 0], e[:, 1])
-    early = t_ms[keep] < (result.times[0] + startup) * 1e3
-    if early.all():  # no steady state: the whole run coloured by time
-        early[:] = False
+    split = (result.times[0] + startup) * 1e3
+    if split >= t_ms[-1]:  # no steady state: the whole run coloured by time
+        split = float(t_ms[0])
+    early, late = keep[t_ms[keep] < split], keep[t_ms[keep] >= split]
     fig = new_figure(6.6, 5.8)
     ax = fig.add_axes((0.13, 0.1, 0.66, 0.8))
     cax = fig.add_axes((0.83, 0.18, 0.03, 0.64))
     th = np.linspace(0, 2 * np.pi, 400)
     ax.plot(c * np.cos(th), c * np.sin(th), color="k", lw=1.2, label=f"clearance circle (c = {c:g} µm)")
-    if early.any():
-        ax.plot(e[keep[early], 0], e[keep[early], 1], color="0.6", lw=0.5, label="start-up")
-    late = keep[~early]
-    pts = e[late]
-    segments = list(np.stack([pts[:-1], pts[1:]], axis=1))
-    lc = LineCollection(segments, cmap="viridis", lw=0.9, label="steady state")
-    lc.set_array(t_ms[late][:-1])
-    ax.add_collection(lc)
+    if len(early):
+        ax.plot(e[early, 0], e[early, 1], color="0.6", lw=0.5, label="start-up")
+    edges = np.linspace(split, float(t_ms[-1]), 13)
+    norm = BoundaryNorm(edges, 12)
+    cmap = colormaps["viridis"].resampled(12)
+    part = np.clip(np.searchsorted(edges, t_ms[late], side="right") - 1, 0, 11)
+    for k in range(12):
+        idx = late[part == k]
+        if len(idx):
+            idx = np.concatenate([idx, late[part == k + 1][:1]])  # joined to the next span
+            ax.plot(e[idx, 0], e[idx, 1], color=cmap(k), lw=0.9, label="steady state" if k == 0 else None)
     ax.plot(e[0, 0], e[0, 1], "o", color="C3", ms=5, label="start")
-    fig.colorbar(lc, cax=cax, label="time [ms]")
+    bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), cax=cax, label="time [ms]")
+    bar.set_ticks(edges[::3].tolist())
+    bar.ax.yaxis.set_major_formatter(FormatStrFormatter("%.4g"))
     ax.set_aspect("equal")
     lim = 1.15 * max(c, float(np.abs(e).max()) if len(e) else c)
     ax.set_xlim(-lim, lim)
