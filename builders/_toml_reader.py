@@ -8,6 +8,7 @@ and the key.
 
 from __future__ import annotations
 
+import math
 import re
 from collections.abc import Sequence
 from typing import Any, Literal, TypeVar, overload
@@ -80,7 +81,8 @@ class Locator:
 
 
 def _is_number(v: Any) -> bool:
-    return isinstance(v, (int, float)) and not isinstance(v, bool)
+    """A finite int or float (TOML also reads ``inf`` and ``nan``, which no scenario value may be)."""
+    return isinstance(v, (int, float)) and not isinstance(v, bool) and math.isfinite(v)
 
 
 class Table:
@@ -141,7 +143,7 @@ class Table:
             return self._default(default, f"'{key}'")
         v = self.raw(key)
         if not _is_number(v):
-            raise self.error(key, f"must be a number (got {v!r})")
+            raise self.error(key, f"must be a finite number (got {v!r})")
         return v
 
     def _unit_key(self, base: str, quantity: str) -> tuple[str, float] | None:
@@ -171,7 +173,7 @@ class Table:
         key, factor = hit
         v = self.data[key]
         if not _is_number(v):
-            raise self.error(key, f"must be a number (got {v!r})")
+            raise self.error(key, f"must be a finite number (got {v!r})")
         return v * factor if factor != 1.0 else v
 
     def pair(self, base: str, quantity: str, default: tuple[float, float] | None = None) -> tuple[float, float]:
@@ -185,7 +187,7 @@ class Table:
     def convert_pair(self, key: str, v: Any, factor: float) -> tuple[float, float]:
         """Check and convert an (x, y) value read from ``key``."""
         if not (isinstance(v, list) and len(v) == 2 and all(_is_number(x) for x in v)):
-            raise self.error(key, f"must be a pair of numbers [x, y] (got {v!r})")
+            raise self.error(key, f"must be a pair of finite numbers [x, y] (got {v!r})")
         return tuple(x * factor if factor != 1.0 else x for x in v)
 
     @overload

@@ -63,13 +63,18 @@ def load_scenario(path: str | os.PathLike[str]) -> Mechanism:
     """Read a scenario file and return its `Mechanism`.
 
     Raises:
-        ScenarioError: the file is not valid TOML, a key is missing, unknown or has a bad
-            unit, a name refers to nothing, the mechanism is invalid, or its loops cannot
-            be closed at t = 0. The message names file, line, table and key.
+        ScenarioError: the file is not UTF-8 text or not valid TOML, a key is missing,
+            unknown or has a bad unit, a name refers to nothing, the mechanism is invalid,
+            or its loops cannot be closed at t = 0. The message names file, line, table
+            and key.
         OSError: the file cannot be read.
     """
     p = Path(path)
-    return loads_scenario(p.read_text(encoding="utf-8"), source=str(p))
+    try:
+        text = p.read_text(encoding="utf-8")
+    except UnicodeDecodeError as e:
+        raise ScenarioError(f"not a TOML text file (not UTF-8: {e.reason} at byte {e.start})", path=str(p)) from None
+    return loads_scenario(text, source=str(p))
 
 
 def loads_scenario(text: str, *, source: str = "<string>") -> Mechanism:
@@ -82,6 +87,15 @@ def loads_scenario(text: str, *, source: str = "<string>") -> Mechanism:
     top = Table(doc, (), "", loc)
     mech = top.sub("mechanism", "[mechanism]", required=True)
     mech.label = "[mechanism]"
+    if not mech.has("builder") and not any(top.has(k) for k in ("links", "joints")):
+        from clearance.builders.catalogue import CATALOGUE
+
+        raise mech.error(
+            None,
+            "missing key 'builder': a scenario names a catalogue builder (builder = \"slider_crank\"; one of: "
+            f"{', '.join(CATALOGUE)}) with keyword overrides, or describes a whole mechanism with name, "
+            "[[links]], [[joints]], [[drives]] and [[outputs]]",
+        )
     if mech.has("builder"):
         others = [k for k in ("links", "joints", "drives", "outputs") if top.has(k)]
         if others:
@@ -90,9 +104,13 @@ def loads_scenario(text: str, *, source: str = "<string>") -> Mechanism:
             )
         top.finish(["mechanism"])
         return from_builder(mech)
-    mechanism = _read_full(top, mech)
     try:
+        mechanism = _read_full(top, mech)
         assemble(mechanism)
+    except ArithmeticError as e:  # sizes that over- or underflow (a link of 1e300 m)
+        raise ScenarioError(
+            f"the mechanism's sizes cannot be computed with ({e}); check its numbers", path=source
+        ) from None
     except SingularPositionError as e:
         raise ScenarioError(f"the mechanism starts in a singular position at t = 0: {e}", path=source) from None
     except AssemblyError as e:

@@ -218,7 +218,7 @@ def test_report_writes_markdown_and_figures(tmp_path):
 
 
 def test_cli_sweep_and_rank(tmp_path, capsys):
-    common = ["--rpm", "1000", "--timestep-us", "5", "--segments", "36", "--workers", "1", "--no-progress"]
+    common = ["--rpm", "1000", "--timestep-us", "5", "--workers", "1", "--no-progress"]
     rc = main_sweep(
         [
             "--points",
@@ -317,8 +317,6 @@ def test_cli_sweeps_and_ranks_the_press(tmp_path, monkeypatch, capsys):
         "90",
         "--timestep-us",
         "10",
-        "--segments",
-        "36",
         "--workers",
         "1",
         "--no-progress",

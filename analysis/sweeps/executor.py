@@ -6,12 +6,20 @@ local process pool with the ``spawn`` context (shut down on exit, pending work c
 Sweep callables must be picklable (module-level functions or `functools.partial`), since
 every point runs in another process. `Progress` is a tqdm bar, or nothing when progress is
 off.
+
+The local pool's workers never outlive the process that started them: each watches its
+parent's pid from a thread and exits when the parent is gone (killed with SIGKILL, say, when
+nothing can be cleaned up), and each ignores SIGINT, so a Ctrl-C reaches the parent alone,
+which ends its workers at once (`terminate_workers`) instead of waiting for their points.
 """
 
 from __future__ import annotations
 
 import multiprocessing
 import os
+import signal
+import threading
+import time
 from collections.abc import Iterator
 from concurrent.futures import Executor, ProcessPoolExecutor
 from contextlib import contextmanager
@@ -21,7 +29,61 @@ from typing import TYPE_CHECKING
 if TYPE_CHECKING:
     from tqdm import tqdm
 
-__all__ = ["Pool", "Progress", "open_executor"]
+__all__ = [
+    "PARENT_POLL_S",
+    "DASK_INSTALL",
+    "Pool",
+    "Progress",
+    "SchedulerError",
+    "open_executor",
+    "require_dask",
+    "terminate_workers",
+]
+
+PARENT_POLL_S = 0.2
+"""How often a local worker checks that its parent is alive [s]."""
+
+DASK_INSTALL = "pip install 'dask[distributed]'"
+"""The command that installs what a Dask scheduler address needs."""
+
+
+class SchedulerError(RuntimeError):
+    """A Dask scheduler cannot be used: Dask is not installed, or the scheduler cannot be reached."""
+
+
+def require_dask() -> None:
+    """Check that ``dask.distributed`` can be imported.
+
+    Raises:
+        SchedulerError: it cannot; the message gives the install command.
+    """
+    try:
+        import dask.distributed  # noqa: F401
+    except ImportError:
+        raise SchedulerError(
+            f"a Dask scheduler needs dask.distributed, which is not installed: {DASK_INSTALL}"
+        ) from None
+
+
+def _watch_parent(parent: int) -> None:
+    while True:
+        time.sleep(PARENT_POLL_S)
+        if os.getppid() != parent:
+            os._exit(1)
+
+
+def _init_worker(parent: int) -> None:
+    """Initializer of a local worker: ignore SIGINT, exit when the parent ``parent`` is gone."""
+    signal.signal(signal.SIGINT, signal.SIG_IGN)
+    threading.Thread(target=_watch_parent, args=(parent,), name="parent-watch", daemon=True).start()
+
+
+def terminate_workers(pool: ProcessPoolExecutor) -> None:
+    """End a local pool's worker processes now (their running tasks are lost) and shut it down."""
+    for proc in list((getattr(pool, "_processes", None) or {}).values()):
+        if proc.is_alive():
+            proc.terminate()
+    pool.shutdown(wait=False, cancel_futures=True)
 
 
 @dataclass(frozen=True)
@@ -49,24 +111,38 @@ def open_executor(
 
     Yields:
         `Pool` with the executor and its number of slots (workers or Dask threads).
+
+    Raises:
+        SchedulerError: Dask is not installed, or the scheduler cannot be reached.
     """
     if executor is not None:
         yield Pool(executor, max_workers or getattr(executor, "_max_workers", None) or os.cpu_count() or 1)
         return
     if scheduler_address is not None:
+        require_dask()
         from dask.distributed import Client
 
-        client = Client(scheduler_address)
+        try:
+            client = Client(scheduler_address)
+        except (OSError, TimeoutError, ValueError) as err:
+            raise SchedulerError(f"cannot reach the Dask scheduler at {scheduler_address!r}: {err}") from None
         try:
             yield Pool(client.get_executor(), max(1, sum(client.nthreads().values())))
         finally:
             client.close()
         return
-    pool = ProcessPoolExecutor(max_workers=max_workers, mp_context=multiprocessing.get_context("spawn"))
+    pool = ProcessPoolExecutor(
+        max_workers=max_workers,
+        mp_context=multiprocessing.get_context("spawn"),
+        initializer=_init_worker,
+        initargs=(os.getpid(),),
+    )
     try:
         yield Pool(pool, max_workers or os.cpu_count() or 1)
-    finally:
-        pool.shutdown(wait=True, cancel_futures=True)
+    except BaseException:
+        terminate_workers(pool)  # interrupted or failed: the running tasks' results are not wanted
+        raise
+    pool.shutdown(wait=True, cancel_futures=True)
 
 
 class Progress:

@@ -185,18 +185,53 @@ class RunStore:
     def _digest_path(self, name: str) -> Path:
         return self.folder / f"{name}.digest.json"
 
+    def _read(self, name: str) -> dict[str, Any]:
+        """The digest file of a run as read.
+
+        Raises:
+            FileNotFoundError: no such run in the store.
+            ValueError: the file is unreadable (cut short, say); the message says why.
+        """
+        d = json.loads(self._digest_path(name).read_text(encoding="utf-8"))
+        if not isinstance(d, dict):
+            raise ValueError(f"a JSON object was expected, not {type(d).__name__}")
+        return d
+
     def has(self, spec: RunSpec) -> bool:
-        """The run is on disk with the same key."""
-        p = self._digest_path(spec.name)
-        return p.exists() and json.loads(p.read_text()).get("key") == spec.key()
+        """The run is on disk with the same key.
+
+        An unreadable digest (cut short, say) counts as not on disk, with a `RuntimeWarning`
+        naming it, so `run_batch` simulates that run again and replaces the file.
+        """
+        import warnings
+
+        if not self._digest_path(spec.name).exists():
+            return False
+        try:
+            return self._read(spec.name).get("key") == spec.key()
+        except ValueError as err:
+            warnings.warn(
+                f"run digest {self._digest_path(spec.name)} is unreadable ({err}); run '{spec.name}' is "
+                "simulated again",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+            return False
 
     def digest(self, name: str) -> RunDigest:
         """The run's `RunDigest`.
 
         Raises:
             FileNotFoundError: no such run in the store.
+            ValueError: its digest file is unreadable.
         """
-        d = json.loads(self._digest_path(name).read_text())
+        try:
+            d = self._read(name)
+        except ValueError as err:
+            raise ValueError(
+                f"run digest {self._digest_path(name)} is unreadable ({err}); delete it and run the batch "
+                f"again to simulate run '{name}' anew"
+            ) from None
         d.pop("key", None)
         return RunDigest(**d)
 

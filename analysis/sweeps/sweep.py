@@ -276,9 +276,28 @@ def _csv_text(rows: Sequence[Mapping[str, Any]]) -> str:
 
 
 def load_rows(out_dir: str | Path) -> list[dict[str, Any]]:
-    """All point rows of a sweep folder, sorted by point index."""
-    files = sorted((Path(out_dir) / "points").glob("point_*.json"))
-    return sorted((json.loads(p.read_text()) for p in files), key=lambda r: r["index"])
+    """All point rows of a sweep folder, sorted by point index.
+
+    A point file that cannot be read (cut short when a disk filled, say) is left out with a
+    `RuntimeWarning` naming it: `run_sweep` then computes that point again and replaces it.
+    """
+    import warnings
+
+    rows = []
+    for p in sorted((Path(out_dir) / "points").glob("point_*.json")):
+        try:
+            row = json.loads(p.read_text(encoding="utf-8"))
+            int(row["index"])
+        except (ValueError, TypeError, KeyError) as err:
+            warnings.warn(
+                f"point file {p} is unreadable ({type(err).__name__}: {err}); that point is treated as not run, "
+                "and rerunning the sweep computes it again",
+                RuntimeWarning,
+                stacklevel=2,
+            )
+            continue
+        rows.append(row)
+    return sorted(rows, key=lambda r: r["index"])
 
 
 def _describe(obj: object) -> str:
@@ -316,7 +335,13 @@ def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str,
     path = out / "sweep.json"
     manifest = _json_safe({"points": points, "settings": settings})
     if path.exists():
-        old = json.loads(path.read_text())
+        try:
+            old = json.loads(path.read_text(encoding="utf-8"))
+        except ValueError as err:
+            raise ValueError(
+                f"{path} is unreadable ({err}); it records which sweep {out} holds, so its points cannot be "
+                "reused safely: delete that folder to start over, or give another out_dir"
+            ) from None
         if old != manifest:
             old_settings = old.get("settings", {})
             diffs = [

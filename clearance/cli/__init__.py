@@ -19,7 +19,9 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
+import warnings
 from collections.abc import Callable
+from typing import TextIO
 
 from clearance.contact_plugin import PluginUnavailableError
 from clearance.kinematics import AssemblyError
@@ -67,9 +69,35 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _show_warning(
+    message: Warning | str,
+    category: type[Warning],
+    filename: str,
+    lineno: int,
+    file: TextIO | None = None,
+    line: str | None = None,
+) -> None:
+    """Warnings as one line on stderr (``warning: ...``), without the source location."""
+    print(f"warning: {message}", file=sys.stderr)
+
+
 def main(argv: list[str] | None = None) -> int:
-    """Entry point of the `clearance` console script; returns the process exit status."""
+    """Entry point of the `clearance` console script; returns the process exit status.
+
+    Exit statuses: 0 done, 1 some sweep points failed, 2 refused (bad input) or stopped by
+    an error, 3 a sweep stopped early (resumable), 130 interrupted with Ctrl-C.
+    """
     argv = list(sys.argv[1:] if argv is None else argv)
+    with warnings.catch_warnings():
+        warnings.showwarning = _show_warning
+        try:
+            return _dispatch(argv)
+        except KeyboardInterrupt:
+            print("interrupted", file=sys.stderr)
+            return 130
+
+
+def _dispatch(argv: list[str]) -> int:
     if argv and argv[0] in _OWN_PARSER:
         module, func, _ = _OWN_PARSER[argv[0]]
         entry: Callable[[list[str]], int] = getattr(importlib.import_module(module), func)

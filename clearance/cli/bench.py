@@ -15,6 +15,9 @@ from collections.abc import Sequence
 
 from clearance.bench.scenarios import default_scenarios, write_report
 from clearance.bench.speed_error import run_speed_error
+from clearance.cli.options import positive
+from clearance.cli.paths import FolderBusyError, check_folder, folder_lock
+from clearance.cli.sweep_common import INTERRUPTED
 
 __all__ = ["bench_parser", "main_bench"]
 
@@ -39,7 +42,12 @@ def bench_parser() -> argparse.ArgumentParser:
         help="only the settings whose key matches one of these shell patterns (e.g. 'exact_*' "
         "'calibrated_h2us_Nrule_*'; keys as in the output folder's file names); the reference always runs",
     )
-    p.add_argument("--workers", type=int, default=None, help="processes for the accuracy runs (default: CPU count)")
+    p.add_argument(
+        "--workers",
+        type=positive(int, "--workers"),
+        default=None,
+        help="processes for the accuracy runs (default: CPU count)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     return p
 
@@ -49,8 +57,17 @@ def _matches(key: str, patterns: Sequence[str]) -> bool:
 
 
 def main_bench(argv: Sequence[str] | None = None) -> int:
-    """Entry point of ``clearance bench``."""
+    """Entry point of ``clearance bench``.
+
+    Exit codes: 0 done, 2 a usage error (or no runs to report), 130 interrupted (Ctrl-C;
+    the finished runs are kept).
+    """
     args = bench_parser().parse_args(argv)
+    try:
+        out = check_folder(args.out, "--out")
+    except ValueError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
     scenarios = default_scenarios(args.quick)
     if args.scenarios:
         known = {s.name for s in scenarios}
@@ -67,12 +84,20 @@ def main_bench(argv: Sequence[str] | None = None) -> int:
         if not any(s.settings for s in scenarios):
             print(f"error: --settings {' '.join(args.settings)} matches no setting", file=sys.stderr)
             return 2
-    if args.workers is not None and args.workers < 1:
-        print(f"error: --workers must be >= 1 (got {args.workers})", file=sys.stderr)
-        return 2
     stages = {"all": ("accuracy", "timing"), "report": ()}.get(args.stage, (args.stage,))
-    run_speed_error(scenarios, args.out, stages=stages, max_workers=args.workers, progress=not args.no_progress)
-    if args.stage in ("all", "report"):
-        path = write_report(scenarios, args.out, command="clearance bench " + " ".join(argv or sys.argv[2:]))
-        print(f"wrote {path} and {path.with_suffix('.png')}")
+    try:
+        with folder_lock(out):
+            run_speed_error(scenarios, out, stages=stages, max_workers=args.workers, progress=not args.no_progress)
+            if args.stage in ("all", "report"):
+                path = write_report(scenarios, out, command="clearance bench " + " ".join(argv or sys.argv[2:]))
+                print(f"wrote {path} and {path.with_suffix('.png')}")
+    except FileNotFoundError as err:  # the report of runs that are not there
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    except FolderBusyError as err:
+        print(f"error: {err}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print(f"interrupted; the finished runs are kept in {out}, rerun to resume", file=sys.stderr)
+        return INTERRUPTED
     return 0

@@ -10,11 +10,13 @@ import numpy as np
 
 from clearance.cli.options import (
     add_scenario_args,
+    bounded,
     mechanism_from_args,
     options_from_args,
-    positive,
 )
-from clearance.options import ContactMode
+from clearance.cli.paths import check_folder, folder_lock
+from clearance.model import Mechanism
+from clearance.options import ContactMode, ModelOptions
 
 __all__ = ["calibrate_parser", "main_calibrate"]
 
@@ -34,7 +36,7 @@ def calibrate_parser() -> argparse.ArgumentParser:
     g = p.add_argument_group("fit")
     g.add_argument(
         "--speeds",
-        type=positive(float, "--speeds"),
+        type=bounded(float, "--speeds", hi=100.0, why="a pin joint's impacts are slower than 100 m/s"),
         nargs=2,
         metavar=("LO", "HI"),
         default=None,
@@ -43,9 +45,9 @@ def calibrate_parser() -> argparse.ArgumentParser:
     )
     g.add_argument(
         "--n-speeds",
-        type=positive(int, "--n-speeds"),
+        type=bounded(int, "--n-speeds", 2, 64, why="each speed is one more impact simulated at every fit step"),
         default=None,
-        help="number of log-spaced speeds between LO and HI (with --speeds only; default 8)",
+        help="number of log-spaced speeds between LO and HI, 2 to 64 (with --speeds only; default 8)",
     )
     g.add_argument("--no-cache", action="store_true", help="refit even if a calibration file exists")
     p.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
@@ -64,9 +66,6 @@ def main_calibrate(argv: Sequence[str] | None = None) -> int:
         0 on success, 2 on bad input or an unstable calibration.
     """
     from clearance.contact_calibration.fit import CalibrationStabilityError
-    from clearance.contact_calibration.report import calibration_report
-    from clearance.contact_calibration.store import calibrate_joint
-    from clearance.run.preparation import prepare
 
     p = calibrate_parser()
     args = p.parse_args(argv)
@@ -77,33 +76,42 @@ def main_calibrate(argv: Sequence[str] | None = None) -> int:
             "--n-speeds needs --speeds LO HI (the default fit uses 8 speeds from impact speed / 50 "
             "to impact speed, the ones a calibrated run reuses)"
         )
-    if args.n_speeds is not None and args.n_speeds < 2:
-        p.error(f"--n-speeds must be at least 2 (got {args.n_speeds})")
     try:
+        out = check_folder(args.out, "--out")
         mech = mechanism_from_args(args)
         if not mech.clearance_joints:
             raise ValueError(f"mechanism '{mech.name}' has no clearance joint to calibrate (see --clearance-at)")
         options = options_from_args(args)
-        prep = prepare(mech, options)
-        speeds = np.geomspace(args.speeds[0], args.speeds[1], args.n_speeds or 8) if args.speeds else None
-        for j in mech.clearance_joints:
-            ring = prep.built.rings[j.name]
-            result, path = calibrate_joint(
-                j, ring, prep.sizing[j.name], options, speeds=speeds, use_cache=not args.no_cache
-            )
-            files = calibration_report(
-                result,
-                j.require_clearance(),
-                ring,
-                options,
-                out_dir=args.out,
-                stem=f"calibration_{j.name}",
-                title=f"Contact calibration: {j.name}",
-                source=str(path) if path else None,
-            )
-            print(files.markdown.read_text())
-            print(f"wrote {files.markdown} and {files.plot}")
+        with folder_lock(out):
+            _calibrate(args, mech, options)
     except (ValueError, CalibrationStabilityError) as exc:
         print(f"clearance calibrate: error: {exc}", file=sys.stderr)
         return 2
     return 0
+
+
+def _calibrate(args: argparse.Namespace, mech: Mechanism, options: ModelOptions) -> None:
+    """Calibrate every clearance joint of ``mech`` and write its report in ``args.out``."""
+    from clearance.contact_calibration.report import calibration_report
+    from clearance.contact_calibration.store import calibrate_joint
+    from clearance.run.preparation import prepare
+
+    prep = prepare(mech, options)
+    speeds = np.geomspace(args.speeds[0], args.speeds[1], args.n_speeds or 8) if args.speeds else None
+    for j in mech.clearance_joints:
+        ring = prep.built.rings[j.name]
+        result, path = calibrate_joint(
+            j, ring, prep.sizing[j.name], options, speeds=speeds, use_cache=not args.no_cache
+        )
+        files = calibration_report(
+            result,
+            j.require_clearance(),
+            ring,
+            options,
+            out_dir=args.out,
+            stem=f"calibration_{j.name}",
+            title=f"Contact calibration: {j.name}",
+            source=str(path) if path else None,
+        )
+        print(files.markdown.read_text())
+        print(f"wrote {files.markdown} and {files.plot}")

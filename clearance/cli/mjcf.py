@@ -31,9 +31,11 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 def command(args: argparse.Namespace) -> int:
     """Write the model; returns the exit status."""
+    from clearance.cli.paths import check_file
     from clearance.results import atomic_write_text
     from clearance.run.preparation import prepare
 
+    check_file(args.out, "--out", example="model.xml")
     mech = mechanism_from_args(args)
     if args.ideal:
         mech = mech.ideal_twin()

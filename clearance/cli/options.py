@@ -17,6 +17,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import TypeVar
 
+from clearance.cli.limits import MAX_DRIVE_RPM, MAX_SEGMENTS, check_mechanism
 from clearance.contact_plugin import is_available as plugin_available
 from clearance.model import Mechanism
 from clearance.options import DEFAULT_TIMESTEP, ContactMode, GeomType, ModelOptions
@@ -24,9 +25,12 @@ from clearance.units import UNITS
 
 __all__ = [
     "NUMERICS_FLAGS",
+    "DEFAULT_MECHANISM",
     "si",
     "positive",
+    "bounded",
     "add_clearance_mm",
+    "check_clearance_at",
     "add_sweep_args",
     "sweep_out",
     "sweep_options",
@@ -46,6 +50,12 @@ NUMERICS_FLAGS = {
     "--contact-mode": "contact_mode",
 }
 """MuJoCo-only options: flag -> argparse destination."""
+
+RING_FLAGS = ("--segments", "--journal-geom", "--segment-geom")
+"""Numerics of the ring of segments, which the exact contact does not have."""
+
+DEFAULT_MECHANISM = "slider_crank"
+"""The mechanism of a command given neither ``--mechanism`` nor ``--scenario``."""
 
 JOURNAL_GEOMS = tuple(g.value for g in GeomType if g is not GeomType.BOX)
 SEGMENT_GEOMS = tuple(g.value for g in GeomType)
@@ -70,17 +80,67 @@ def si(value: float, unit: str) -> float:
 
 def positive(kind: type[_N], name: str) -> Callable[[str], _N]:
     """An argparse ``type`` accepting finite numbers > 0 of ``kind`` (int or float)."""
+    return bounded(kind, name)
+
+
+def bounded(
+    kind: type[_N], name: str, lo: float | None = None, hi: float | None = None, why: str = ""
+) -> Callable[[str], _N]:
+    """An argparse ``type`` accepting finite numbers of ``kind`` in [lo, hi] (lo None: > 0).
+
+    Args:
+        kind: int or float.
+        name: the option, for the message.
+        lo: smallest accepted value; None accepts any value above 0.
+        hi: largest accepted value (None: no bound).
+        why: the reason for ``hi``, appended to the message when it is exceeded.
+    """
 
     def conv(text: str) -> _N:
         try:
             v = kind(text)
         except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
-        if not (math.isfinite(v) and v > 0):
+            what = "a whole number" if kind is int else "a number"
+            raise argparse.ArgumentTypeError(f"{name} must be {what} (got {text!r})") from None
+        if not math.isfinite(v):
+            raise argparse.ArgumentTypeError(f"{name} must be a finite number (got {text})")
+        if lo is None and not v > 0:
             raise argparse.ArgumentTypeError(f"{name} must be > 0 (got {text})")
+        if lo is not None and v < lo:
+            raise argparse.ArgumentTypeError(f"{name} must be at least {lo:g} (got {text})")
+        if hi is not None and v > hi:
+            raise argparse.ArgumentTypeError(f"{name} must be at most {hi:,g} (got {text}){'; ' + why if why else ''}")
         return v
 
     return conv
+
+
+def rpm_option(name: str) -> Callable[[str], float]:
+    """The argparse ``type`` of a drive speed in rpm: > 0 and at most `MAX_DRIVE_RPM`."""
+    return bounded(
+        float,
+        name,
+        hi=MAX_DRIVE_RPM,
+        why="faster, the journals are pressed deeper than their clearance and runs diverge "
+        "(clearance.checks.MAX_DRIVE_RPM)",
+    )
+
+
+def timestep_option(name: str = "--timestep-us") -> Callable[[str], float]:
+    """The argparse ``type`` of a time step in µs: > 0 and at most 10,000 (ModelOptions' 0.01 s)."""
+    return bounded(float, name, hi=1e4, why="a step of 10 ms (0.01 s) is the longest MuJoCo is given here")
+
+
+def segments_option(name: str = "--segments") -> Callable[[str], int]:
+    """The argparse ``type`` of a ring's segment count: 8 to `MAX_SEGMENTS`."""
+    return bounded(
+        int,
+        name,
+        8,
+        MAX_SEGMENTS,
+        why="the ripple rule picks 144 for the default scenario, and preparing a ring takes longer the more "
+        "segments it has (100,000 never finish)",
+    )
 
 
 def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, contact_mode: bool = True) -> None:
@@ -98,17 +158,17 @@ def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, cont
 
     g.add_argument(
         "--mechanism",
-        default="slider_crank",
+        default=None,
         choices=sorted(CATALOGUE),
         metavar="NAME",
-        help="mechanism from the catalogue (default: slider_crank; one of: " + ", ".join(sorted(CATALOGUE)) + ")",
+        help=f"mechanism from the catalogue (default: {DEFAULT_MECHANISM}; one of: {', '.join(sorted(CATALOGUE))})",
     )
     g.add_argument(
         "--scenario",
         default=None,
         metavar="TOML",
         help="scenario file (a catalogue builder with overrides, or a whole mechanism); "
-        "replaces --mechanism and the options below",
+        "replaces --mechanism and the options below (giving both is refused)",
     )
     add_clearance_mm(g)
     g.add_argument(
@@ -121,9 +181,10 @@ def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, cont
     )
     g.add_argument(
         "--rpm",
-        type=positive(float, "--rpm"),
+        type=rpm_option("--rpm"),
         default=None,
-        help="speed of the driven crank [rpm] (the press: crank 2; default: the builder's, 5000 for the slider-crank)",
+        help="speed of the driven crank [rpm] (the press: crank 2; default: the builder's, 5000 for the "
+        f"slider-crank; at most {MAX_DRIVE_RPM:,.0f})",
     )
     g.add_argument("--gravity", action="store_true", help="gravity 9.81 m/s² along -y")
     if numerics:
@@ -140,16 +201,28 @@ def add_numerics_args(p: argparse.ArgumentParser, *, contact_mode: bool = True) 
     steps = ", ".join(f"{m.value} {h * 1e6:g}" for m, h in DEFAULT_TIMESTEP.items())
     g.add_argument(
         "--timestep-us",
-        type=positive(float, "--timestep-us"),
+        type=timestep_option(),
         default=None,
         help=f"time step [µs] (default: the contact mode's, {steps}; see benchmarks/speed_error.md)",
     )
     g.add_argument(
-        "--segments", type=int, default=None, help="bearing segment count N (default: chosen by the ripple rule)"
+        "--segments",
+        type=segments_option(),
+        default=None,
+        help=f"bearing segment count N, 8 to {MAX_SEGMENTS} (ring contact modes only; default: chosen by the "
+        "ripple rule)",
     )
-    g.add_argument("--journal-geom", default="sphere", choices=JOURNAL_GEOMS, help="journal geom (default sphere)")
     g.add_argument(
-        "--segment-geom", default="sphere", choices=SEGMENT_GEOMS, help="bearing segment geom (default sphere)"
+        "--journal-geom",
+        default=None,
+        choices=JOURNAL_GEOMS,
+        help="journal geom (ring contact modes only; default sphere)",
+    )
+    g.add_argument(
+        "--segment-geom",
+        default=None,
+        choices=SEGMENT_GEOMS,
+        help="bearing segment geom (ring contact modes only; default sphere)",
     )
     if contact_mode:
         g.add_argument(
@@ -173,29 +246,61 @@ def mechanism_from_args(args: argparse.Namespace) -> Mechanism:
     """The scenario's `Mechanism`: a scenario file, or a catalogue builder with the options given.
 
     Raises:
-        ValueError: an option given with ``--scenario``, or one the builder does not take.
+        ValueError: an option given with ``--scenario``, or one the builder does not take; a
+            scenario file that cannot be read; a mechanism outside `clearance.cli.limits`.
         ScenarioError, AssemblyError: a bad scenario (both are ValueErrors).
     """
-    from clearance.builders import CATALOGUE, load_scenario
+    if args.scenario is not None:
+        mech = _scenario_from_args(args)
+        check_mechanism(mech, f"--scenario {args.scenario}")
+        return mech
+    mech = _catalogue_from_args(args)
+    given = " ".join(
+        f"{flag} {v:g}" for flag, v in (("--clearance-mm", args.clearance_mm), ("--rpm", args.rpm)) if v is not None
+    )
+    check_mechanism(mech, f"--mechanism {args.mechanism or DEFAULT_MECHANISM}" + (f" {given}" if given else ""))
+    return mech
 
-    if args.scenario:
-        given = [
-            o
-            for o, v in (
-                ("--clearance-mm", args.clearance_mm),
-                ("--clearance-at", args.clearance_at),
-                ("--rpm", args.rpm),
-            )
-            if v is not None
-        ]
-        if args.gravity:
-            given.append("--gravity")
-        if given:
-            raise ValueError(
-                f"{', '.join(given)}: give these in the scenario file {args.scenario}, not with --scenario"
-            )
-        return load_scenario(args.scenario)
-    entry = CATALOGUE[args.mechanism]
+
+def _scenario_from_args(args: argparse.Namespace) -> Mechanism:
+    """The mechanism of ``--scenario``, refusing the options it replaces."""
+    from clearance.builders import load_scenario
+
+    given = [
+        o
+        for o, v in (
+            ("--mechanism", args.mechanism),
+            ("--clearance-mm", args.clearance_mm),
+            ("--clearance-at", args.clearance_at),
+            ("--rpm", args.rpm),
+        )
+        if v is not None
+    ]
+    if args.gravity:
+        given.append("--gravity")
+    if given:
+        raise ValueError(
+            f"--scenario {args.scenario} cannot be given with {', '.join(given)}: the scenario file names its "
+            "mechanism and sets its values; change them in the file"
+        )
+    path = Path(args.scenario)
+    if not str(args.scenario):
+        raise ValueError("--scenario: give a scenario file (got an empty path)")
+    if path.is_dir():
+        raise ValueError(f"--scenario {path}: is a folder; give a scenario file (.toml)")
+    try:
+        return load_scenario(path)
+    except OSError as err:
+        raise ValueError(f"--scenario {path}: cannot read it ({err.strerror or type(err).__name__})") from None
+
+
+def _catalogue_from_args(args: argparse.Namespace) -> Mechanism:
+    """The catalogue mechanism of ``--mechanism`` with the options given."""
+    from clearance.builders import CATALOGUE
+
+    name = args.mechanism or DEFAULT_MECHANISM
+    entry = CATALOGUE[name]
+    check_clearance_at(args.clearance_at, name)
     builder, speed = entry.builder, entry.speed_keyword
     accepted = inspect.signature(builder).parameters
     overrides = [
@@ -211,25 +316,65 @@ def mechanism_from_args(args: argparse.Namespace) -> Mechanism:
     refused = [flag for flag, key, _ in overrides if key not in accepted]
     if refused:
         raise ValueError(
-            f"mechanism '{args.mechanism}' does not take {', '.join(refused)} from the command line; "
+            f"mechanism '{name}' does not take {', '.join(refused)} from the command line; "
             "use a scenario file (--scenario)"
         )
     kw = {key: value for _, key, value in overrides}
-    return builder(**kw)
+    try:
+        return builder(**kw)
+    except ValueError as err:  # a value the builder rejects: say which options gave it
+        given = " ".join(flag if key == "gravity" else f"{flag} {_shown(args, flag)}" for flag, key, _ in overrides)
+        raise ValueError(f"--mechanism {name}{' ' + given if given else ''}: {err}") from None
+
+
+def _shown(args: argparse.Namespace, flag: str) -> str:
+    v = getattr(args, flag.lstrip("-").replace("-", "_"))
+    return " ".join(v) if isinstance(v, list) else f"{v:g}"
+
+
+def check_clearance_at(joints: list[str] | None, mechanism: str) -> None:
+    """Refuse ``--clearance-at`` joints that the catalogue mechanism cannot give a clearance, or repeated.
+
+    Raises:
+        ValueError: naming the joints and the choices.
+    """
+    from clearance.builders import CATALOGUE
+
+    if joints is None:
+        return
+    clearable = CATALOGUE[mechanism].info.clearable
+    unknown = [j for j in joints if j not in clearable]
+    if unknown:
+        raise ValueError(
+            f"--clearance-at {' '.join(unknown)}: unknown joint(s) of mechanism '{mechanism}'; the joints that can "
+            f"carry a clearance are {', '.join(clearable)} (or give none for the ideal mechanism)"
+        )
+    twice = sorted({j for j in joints if joints.count(j) > 1})
+    if twice:
+        raise ValueError(f"--clearance-at names {', '.join(twice)} more than once")
 
 
 def options_from_args(args: argparse.Namespace) -> ModelOptions:
     """`ModelOptions` from the numerics group (SI: the time step in seconds).
 
     Raises:
-        ValueError: a value `ModelOptions` rejects (it names the field).
+        ValueError: a value `ModelOptions` rejects (it names the field); ring numerics
+            (``--segments``, ``--journal-geom``, ``--segment-geom``) with the exact contact,
+            which has no ring.
     """
     mode = contact_mode_from_args(args)
+    if mode is ContactMode.EXACT:
+        ring = [flag for flag in RING_FLAGS if getattr(args, NUMERICS_FLAGS[flag], None) is not None]
+        if ring:
+            raise ValueError(
+                f"{', '.join(ring)}: the exact contact has no ring of segments; these apply to "
+                "--contact-mode calibrated or nominal"
+            )
     return ModelOptions(
         segments=args.segments,
         timestep=0.0 if args.timestep_us is None else si(args.timestep_us, "us"),  # 0: the mode's default
-        journal_geom=GeomType(args.journal_geom),
-        segment_geom=GeomType(args.segment_geom),
+        journal_geom=GeomType(args.journal_geom or GeomType.SPHERE.value),
+        segment_geom=GeomType(args.segment_geom or GeomType.SPHERE.value),
         contact_mode=mode,
     )
 
@@ -252,11 +397,22 @@ def add_clearance_mm(p: argparse.ArgumentParser | argparse._ArgumentGroup, *, wh
 
 def add_sweep_args(p: argparse.ArgumentParser, command: str) -> None:
     """Options every sweep command takes: mechanism, numerics, executor, output, progress."""
-    p.add_argument("--mechanism", default="slider_crank", help="catalogue mechanism (default slider_crank)")
+    from clearance.builders import CATALOGUE
+
     p.add_argument(
-        "--timestep-us", type=positive(float, "--timestep-us"), default=5.0, help="time step [µs] (default 5)"
+        "--mechanism",
+        default=DEFAULT_MECHANISM,
+        choices=sorted(CATALOGUE),
+        metavar="NAME",
+        help=f"catalogue mechanism (default {DEFAULT_MECHANISM}; one of: {', '.join(sorted(CATALOGUE))})",
     )
-    p.add_argument("--segments", type=int, default=None, help="bearing segments N (default: ripple rule)")
+    p.add_argument("--timestep-us", type=timestep_option(), default=5.0, help="time step [µs] (default 5)")
+    p.add_argument(
+        "--segments",
+        type=segments_option(),
+        default=None,
+        help=f"bearing segments N, 8 to {MAX_SEGMENTS} (ring contact modes only; default: ripple rule)",
+    )
     p.add_argument(
         "--contact-mode",
         default=None,
@@ -267,10 +423,20 @@ def add_sweep_args(p: argparse.ArgumentParser, command: str) -> None:
         "--out", default=None, help=f"output folder (default clearance-{command}-<mechanism>); rerun to resume"
     )
     p.add_argument(
-        "--scheduler", default=None, metavar="ADDRESS", help="Dask scheduler address (default: local processes)"
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="Dask scheduler address (default: local processes; needs pip install 'dask[distributed]')",
     )
-    p.add_argument("--workers", type=int, default=None, help="local worker processes (default: CPU count)")
-    p.add_argument("--stop-after", type=int, default=None, help="stop after this many points (resume later)")
+    p.add_argument(
+        "--workers", type=positive(int, "--workers"), default=None, help="local worker processes (default: CPU count)"
+    )
+    p.add_argument(
+        "--stop-after",
+        type=positive(int, "--stop-after"),
+        default=None,
+        help="stop after this many points (resume later)",
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
 
@@ -280,10 +446,17 @@ def sweep_out(args: argparse.Namespace, command: str) -> Path:
 
 
 def sweep_options(args: argparse.Namespace) -> ModelOptions:
-    """`ModelOptions` of a sweep command (its own time-step default; the rest the package's)."""
-    return ModelOptions(
-        timestep=si(args.timestep_us, "us"), segments=args.segments, contact_mode=contact_mode_from_args(args)
-    )
+    """`ModelOptions` of a sweep command (its own time-step default; the rest the package's).
+
+    Raises:
+        ValueError: ``--segments`` with the exact contact, which has no ring.
+    """
+    mode = contact_mode_from_args(args)
+    if mode is ContactMode.EXACT and args.segments is not None:
+        raise ValueError(
+            "--segments: the exact contact has no ring of segments; it applies to --contact-mode calibrated or nominal"
+        )
+    return ModelOptions(timestep=si(args.timestep_us, "us"), segments=args.segments, contact_mode=mode)
 
 
 def contact_mode_from_args(args: argparse.Namespace) -> ContactMode:

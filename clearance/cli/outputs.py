@@ -8,7 +8,21 @@ from pathlib import Path
 from clearance.model import Mechanism, OutputKind
 from clearance.results import SimulationResult
 
-__all__ = ["write_outputs", "duration_from_args"]
+__all__ = ["write_outputs", "duration_from_args", "duration_source", "check_output_paths"]
+
+
+def check_output_paths(args: argparse.Namespace) -> Path:
+    """Check ``--out`` (a folder) and ``--rerun`` (a file) before any work; the folder.
+
+    Raises:
+        ValueError: either cannot be written (`clearance.cli.paths`), with the path and why.
+    """
+    from clearance.cli.paths import check_file, check_folder
+
+    out = check_folder(args.out, "--out")
+    if getattr(args, "rerun", None) is not None:
+        check_file(args.rerun, "--rerun", example="run.rrd")
+    return out
 
 
 def write_outputs(
@@ -38,7 +52,8 @@ def write_outputs(
 
         # the report's Poincaré sections (t = kT of the drive, after the same transient)
         sections = joint_sections(result, skip=skip)
-        print(f"  wrote {record(result, mech, args.rerun, ideal=ideal, poincare=sections)}")
+        rrd = Path(record(result, mech, args.rerun, ideal=ideal, poincare=sections)).resolve()
+        print(f"  rerun recording written to {rrd} (open it with: rerun {rrd})")
     rows = summarise(result, ideal, startup=period or 0.0)
     write_summary_csv(rows, out / "summary.csv")
     write_report(out, result, ideal, skip=skip)
@@ -68,6 +83,15 @@ def write_outputs(
     if rows:
         unit, scale = ("rad", 1.0) if angular else ("mm", 1e3)
         print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * scale:.4g} {unit}")
+
+
+def duration_source(args: argparse.Namespace, default_revolutions: float) -> str:
+    """The options that set the simulated time, for a message (``--duration-ms 5``)."""
+    if args.duration_ms:
+        return f"--duration-ms {args.duration_ms:g}"
+    if args.revolutions is not None:
+        return f"--revolutions {args.revolutions:g}"
+    return f"the default {default_revolutions:g} revolutions"
 
 
 def duration_from_args(args: argparse.Namespace, mech: Mechanism, default_revolutions: float) -> float:

@@ -9,11 +9,15 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Sequence
+from pathlib import Path
 
-from clearance.cli.options import add_sweep_args, positive, si, sweep_options, sweep_out
+from clearance.cli.options import add_sweep_args, bounded, positive, rpm_option, si, sweep_options, sweep_out
+from clearance.cli.paths import check_folder, folder_lock
 from clearance.cli.sweep_common import (
     UsageError,
     catalogue_entry,
+    check_scheduler,
+    interrupted,
     probe,
     report_failures,
     usage_error,
@@ -34,14 +38,19 @@ def rank_parser() -> argparse.ArgumentParser:
     )
     p.add_argument(
         "--rpm",
-        type=positive(float, "--rpm"),
+        type=rpm_option("--rpm"),
         nargs="+",
         default=None,
         help="drive speeds [rpm] (default the catalogue's low speed and the middle of its range: "
         "1000 and 3000 rpm, press 30 and 60 rpm)",
     )
     p.add_argument("--joints", nargs="*", default=None, help="joints (default: all but driven/output ground pivots)")
-    p.add_argument("--periods", type=int, default=6, help="drive periods per run (default 6; the first is skipped)")
+    p.add_argument(
+        "--periods",
+        type=bounded(int, "--periods", 3, why=""),
+        default=6,
+        help="drive periods per run, at least 3 (default 6; the first is skipped)",
+    )
     add_sweep_args(p, "rank")
     return p
 
@@ -50,8 +59,24 @@ def main_rank(argv: Sequence[str] | None = None) -> int:
     """Run ``clearance rank``; writes ``ranking.md`` and ``criticality.png``; returns the exit code.
 
     Exit codes: 0 every point ran, 1 a point failed (the ranking, if any, uses the others),
-    2 a usage error.
+    2 a usage error, 130 interrupted (Ctrl-C; the finished points are kept).
     """
+    args = rank_parser().parse_args(argv)
+    try:
+        out = check_folder(sweep_out(args, "rank"))
+        check_scheduler(args.scheduler)
+    except (UsageError, ValueError) as err:
+        return usage_error(str(err))
+    try:
+        return _rank(args, out)
+    except (UsageError, ValueError) as err:
+        return usage_error(str(err))
+    except KeyboardInterrupt:
+        return interrupted(out)
+
+
+def _rank(args: argparse.Namespace, out: Path) -> int:
+    """The ranking of checked arguments into the checked folder ``out``; returns the exit code."""
     from clearance.analysis.figures.analysis_figures import plot_criticality
     from clearance.analysis.sweeps.criticality import (
         ClearanceAtJoint,
@@ -59,9 +84,9 @@ def main_rank(argv: Sequence[str] | None = None) -> int:
         ranking_markdown,
         run_criticality,
     )
+    from clearance.analysis.sweeps.executor import SchedulerError
     from clearance.results import atomic_write_text
 
-    args = rank_parser().parse_args(argv)
     entry = catalogue_entry(args.mechanism)
     clearable = entry.info.clearable
     if args.joints is not None:
@@ -75,36 +100,48 @@ def main_rank(argv: Sequence[str] | None = None) -> int:
     speeds = [lo, 0.5 * (lo + hi)] if args.rpm is None else [si(r, "rpm") for r in args.rpm]
     clearances = [si(c, "mm") for c in args.clearances_mm]
     make = ClearanceAtJoint(entry.builder, speed_key=entry.speed_keyword)
-    try:
+    options = sweep_options(args)
+    joint = (args.joints or entry.info.criticality or clearable)[0]
+    # every clearance and speed on its own (the bounds of clearance.cli.limits are per value)
+    for c, c_mm in zip(clearances, args.clearances_mm):
         probe(
             make,
-            {"joint": args.joints[0] if args.joints else None, "clearance": clearances[0], "speed": speeds[0]},
+            {"joint": joint, "clearance": c, "speed": speeds[0]},
             args.mechanism,
+            source=f"--mechanism {args.mechanism} --clearances-mm {c_mm:g}",
         )
-    except UsageError as err:
-        return usage_error(str(err))
-    out = sweep_out(args, "rank")
-    try:
-        ranking = run_criticality(
+    for sp in speeds:
+        rpm = sp / si(1, "rpm")
+        probe(
             make,
-            clearances=clearances,
-            speeds=speeds,
-            joints=args.joints,
-            out_dir=out,
+            {"joint": joint, "clearance": clearances[0], "speed": sp},
+            args.mechanism,
+            source=f"--mechanism {args.mechanism} --rpm {rpm:g}",
             periods=args.periods,
-            options=sweep_options(args),
-            scheduler_address=args.scheduler,
-            progress=not args.no_progress,
-            stop_after=args.stop_after,
-            max_workers=args.workers,
+            timestep=options.timestep,
         )
+    try:
+        with folder_lock(out):
+            ranking = run_criticality(
+                make,
+                clearances=clearances,
+                speeds=speeds,
+                joints=args.joints,
+                out_dir=out,
+                periods=args.periods,
+                options=options,
+                scheduler_address=args.scheduler,
+                progress=not args.no_progress,
+                stop_after=args.stop_after,
+                max_workers=args.workers,
+            )
+            table = ranking_markdown(ranking)
+            atomic_write_text(out / "ranking.md", "# Clearance-joint criticality\n\n" + table)
+            plot_criticality(ranking, path=out / "criticality.png")
     except NothingToRankError as err:
         return report_failures(len(err.failed), len(err.failed), err.failed[0][1] if err.failed else "", out)
-    except ValueError as err:
-        return usage_error(str(err))
-    table = ranking_markdown(ranking)
-    atomic_write_text(out / "ranking.md", "# Clearance-joint criticality\n\n" + table)
-    plot_criticality(ranking, path=out / "criticality.png")
+    except SchedulerError as err:
+        return usage_error(f"--scheduler {args.scheduler}: {err}")
     print(table)
     if ranking.failed:
         total = len(ranking.failed) + len(ranking.cells)

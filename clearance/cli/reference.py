@@ -6,14 +6,18 @@ import argparse
 import sys
 from pathlib import Path
 
+from clearance.cli.limits import check_steps
 from clearance.cli.options import (
     add_scenario_args,
+    bounded,
     mechanism_from_args,
     numerics_given,
     positive,
     si,
 )
-from clearance.cli.outputs import duration_from_args, write_outputs
+from clearance.cli.outputs import check_output_paths, duration_from_args, duration_source, write_outputs
+from clearance.cli.paths import folder_lock
+from clearance.model import Mechanism
 
 __all__ = ["add_parser", "command"]
 
@@ -34,7 +38,12 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         default=None,
         help="simulated time [ms] (overrides --revolutions)",
     )
-    f.add_argument("--rtol", type=positive(float, "--rtol"), default=1e-9, help="relative tolerance (default 1e-9)")
+    f.add_argument(
+        "--rtol",
+        type=bounded(float, "--rtol", 1e-13, 1e-3, why="looser, the contact events are not resolved"),
+        default=1e-9,
+        help="relative tolerance, 1e-13 to 1e-3 (default 1e-9)",
+    )
     f.add_argument(
         "--output-us", type=positive(float, "--output-us"), default=10.0, help="output interval [µs] (default 10)"
     )
@@ -46,8 +55,6 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 def command(args: argparse.Namespace) -> int:
     """Run ``clearance reference``; returns the exit status (2: refused or stopped by an error)."""
-    from clearance.reference import ReferenceSolverError, run_reference
-
     given = numerics_given(args)
     if given:
         raise ValueError(
@@ -56,10 +63,25 @@ def command(args: argparse.Namespace) -> int:
             "joint's contact law exactly (no contact mode) and takes adaptive steps (no time step); "
             "set its accuracy with --rtol and its output interval with --output-us"
         )
+    out = check_output_paths(args)
     mech = mechanism_from_args(args)
     duration = duration_from_args(args, mech, 1.0)
-    out = Path(args.out)
     interval = si(args.output_us, "us")
+    if interval > duration:
+        raise ValueError(
+            f"--output-us {args.output_us:g}: the output interval is longer than the run "
+            f"({duration * 1e6:.6g} µs, {duration_source(args, 1.0)})"
+        )
+    check_steps(
+        duration, interval, f"{duration_source(args, 1.0)} --output-us {args.output_us:g}", what="output samples"
+    )
+    with folder_lock(out):
+        return _reference(args, mech, duration, interval, out)
+
+
+def _reference(args: argparse.Namespace, mech: Mechanism, duration: float, interval: float, out: Path) -> int:
+    from clearance.reference import ReferenceSolverError, run_reference
+
     print(
         f"{mech.name} (reference solver): clearance at {[j.name for j in mech.clearance_joints]}, "
         f"{duration * 1e3:.3g} ms, rtol {args.rtol:g}"
@@ -75,8 +97,11 @@ def command(args: argparse.Namespace) -> int:
             return 2
         result = partial
     print(f"  ideal twin (no clearance), {duration * 1e3:.3g} ms, for the deviations")
-    ideal = run_reference(mech.ideal_twin(), duration, output_interval=interval, rtol=args.rtol, progress=progress)
-    out.mkdir(parents=True, exist_ok=True)
+    try:
+        ideal = run_reference(mech.ideal_twin(), duration, output_interval=interval, rtol=args.rtol, progress=progress)
+    except ReferenceSolverError as err:
+        print(f"error: the ideal twin (no clearance), needed for the deviations: {err}", file=sys.stderr)
+        return 2
     write_outputs(args, mech, result, ideal, out)
     print(f"  wall time {result.metadata.get('wall_time_s', float('nan')):.3g} s; wrote {out}/")
     if failed is not None:

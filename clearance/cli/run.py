@@ -6,13 +6,17 @@ import argparse
 import sys
 from pathlib import Path
 
+from clearance.cli.limits import check_steps
 from clearance.cli.options import (
     add_scenario_args,
     mechanism_from_args,
     options_from_args,
     positive,
 )
-from clearance.cli.outputs import duration_from_args, write_outputs
+from clearance.cli.outputs import check_output_paths, duration_from_args, duration_source, write_outputs
+from clearance.cli.paths import folder_lock
+from clearance.model import Mechanism
+from clearance.options import ModelOptions
 
 __all__ = ["add_parser", "command"]
 
@@ -33,7 +37,12 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         default=None,
         help="simulated time [ms] (overrides --revolutions)",
     )
-    r.add_argument("--out", default="clearance-out", help="output folder (default clearance-out)")
+    r.add_argument(
+        "--out",
+        default="clearance-out",
+        help="output folder (default clearance-out); the files a run writes are replaced, others are left alone, "
+        "and a second command writing there at the same time is refused",
+    )
     r.add_argument("--no-progress", action="store_true", help="no progress bar")
     r.add_argument(
         "--rerun",
@@ -45,18 +54,28 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
 
 def command(args: argparse.Namespace) -> int:
-    """Run ``clearance run``; returns the exit status (2: refused or stopped by an error)."""
+    """Run ``clearance run``; returns the exit status (2: refused or stopped by an error).
+
+    Every option, the output folder and the recording's path are checked before any work;
+    the folder is locked (`clearance.cli.paths.folder_lock`) from the preparation of the
+    models to the last file written, and a run refused while preparing leaves no folder.
+    """
+    out = check_output_paths(args)
+    mech = mechanism_from_args(args)
+    options = options_from_args(args)
+    duration = duration_from_args(args, mech, 3.0)
+    check_steps(duration, options.timestep, duration_source(args, 3.0))
+    with folder_lock(out):
+        return _run(args, mech, options, duration, out)
+
+
+def _run(args: argparse.Namespace, mech: Mechanism, options: ModelOptions, duration: float, out: Path) -> int:
     from clearance.results import atomic_write_text
     from clearance.run.preparation import prepare
     from clearance.run.simulation import SimulationError, simulate_prepared
 
-    mech = mechanism_from_args(args)
-    options = options_from_args(args)
-    duration = duration_from_args(args, mech, 3.0)
-    out = Path(args.out)
     prepared = prepare(mech, options)
     ideal_prepared = prepare(mech.ideal_twin(), options)
-    out.mkdir(parents=True, exist_ok=True)  # only once the models are built: a refused run leaves no folder
     atomic_write_text(out / "model.xml", prepared.to_xml())
     atomic_write_text(out / "ideal_model.xml", ideal_prepared.to_xml())
     print(
@@ -74,7 +93,11 @@ def command(args: argparse.Namespace) -> int:
             print(f"error: {failed}", file=sys.stderr)
             return 2
         result = partial
-    ideal = simulate_prepared(ideal_prepared, duration=duration, progress=progress)
+    try:
+        ideal = simulate_prepared(ideal_prepared, duration=duration, progress=progress)
+    except SimulationError as err:
+        print(f"error: the ideal twin (no clearance), needed for the deviations: {err}", file=sys.stderr)
+        return 2
     write_outputs(args, mech, result, ideal, out)
     print(f"  {result.metadata['steps_per_second']:.3g} steps/s; wrote {out}/")
     if failed is not None:

@@ -9,11 +9,26 @@ from __future__ import annotations
 
 import argparse
 from collections.abc import Sequence
+from pathlib import Path
 
-from clearance.cli.options import add_clearance_mm, add_sweep_args, positive, si, sweep_options, sweep_out
+from clearance.cli.limits import MAX_POINTS
+from clearance.cli.options import (
+    add_clearance_mm,
+    add_sweep_args,
+    bounded,
+    check_clearance_at,
+    positive,
+    rpm_option,
+    si,
+    sweep_options,
+    sweep_out,
+)
+from clearance.cli.paths import check_folder, folder_lock
 from clearance.cli.sweep_common import (
     UsageError,
     catalogue_entry,
+    check_scheduler,
+    interrupted,
     probe,
     quantities,
     report_failures,
@@ -41,18 +56,30 @@ def sweep_parser() -> argparse.ArgumentParser:
         default=None,
         help="last value [mm or rpm] (default 1 mm / the catalogue's high speed: 5000 rpm, press 90 rpm)",
     )
-    p.add_argument("--points", type=int, default=200, help="number of values (default 200)")
+    p.add_argument(
+        "--points",
+        type=bounded(int, "--points", 1, MAX_POINTS, why="a sweep's points are all listed in its manifest"),
+        default=200,
+        help=f"number of values, 1 to {MAX_POINTS:,} (default 200)",
+    )
     p.add_argument("--log", action="store_true", help="logarithmic spacing")
     add_clearance_mm(p, what="when sweeping speed")
     p.add_argument(
         "--rpm",
-        type=positive(float, "--rpm"),
+        type=rpm_option("--rpm"),
         default=None,
         help="drive speed when sweeping clearance [rpm] (default the catalogue's high speed)",
     )
     p.add_argument("--quantity", default=None, help="sampled quantity (default <first clearance joint>.ex)")
-    p.add_argument("--periods", type=int, default=60, help="drive periods per point (default 60)")
-    p.add_argument("--sampled", type=int, default=40, help="last periods sampled (default 40)")
+    p.add_argument(
+        "--periods", type=bounded(int, "--periods", 2), default=60, help="drive periods per point (default 60)"
+    )
+    p.add_argument(
+        "--sampled",
+        type=positive(int, "--sampled"),
+        default=40,
+        help="last periods sampled, fewer than --periods (default 40)",
+    )
     p.add_argument(
         "--clearance-at",
         nargs="*",
@@ -68,16 +95,44 @@ def main_sweep(argv: Sequence[str] | None = None) -> int:
     """Run ``clearance sweep``; writes the sweep folder, ``bifurcation.png``; returns the exit code.
 
     Exit codes: 0 every point ran, 1 a point failed (its row has status ``error``), 2 a
-    usage error, 3 stopped before the last point (rerun to resume).
+    usage error, 3 stopped before the last point (rerun to resume), 130 interrupted (Ctrl-C;
+    the finished points are kept).
     """
+    p = sweep_parser()
+    args = p.parse_args(argv)
+    if not args.sampled < args.periods:
+        p.error(f"--sampled {args.sampled} must be below --periods {args.periods} (the first periods are transient)")
+    if args.start is not None and args.stop is not None and args.points > 1 and not args.start < args.stop:
+        p.error(
+            f"--start {args.start:g} must be below --stop {args.stop:g} (each point is run on its own, so the "
+            "order does not matter: swap them)"
+        )
+    if args.parameter == "clearance" and args.clearance_mm is not None:
+        p.error("--clearance-mm sets the clearance of a sweep over speed (--parameter speed); this sweep varies it")
+    if args.parameter == "speed" and args.rpm is not None:
+        p.error("--rpm sets the speed of a sweep over clearance; this sweep varies it (--start, --stop)")
+    try:
+        out = check_folder(sweep_out(args, "sweep"))
+        check_scheduler(args.scheduler)
+    except (UsageError, ValueError) as err:
+        return usage_error(str(err))
+    try:
+        return _sweep(args, out)
+    except (UsageError, ValueError) as err:
+        return usage_error(str(err))
+    except KeyboardInterrupt:
+        return interrupted(out)
+
+
+def _sweep(args: argparse.Namespace, out: Path) -> int:
+    """The sweep of checked arguments into the checked folder ``out``; returns the exit code."""
     import numpy as np
 
-    from clearance.analysis.figures.analysis_figures import plot_bifurcation
-    from clearance.analysis.sweeps.bifurcation import run_bifurcation
+    from clearance.analysis.sweeps.executor import SchedulerError
     from clearance.analysis.sweeps.sweep import KeywordFactory
 
-    args = sweep_parser().parse_args(argv)
     entry = catalogue_entry(args.mechanism)
+    check_clearance_at(args.clearance_at, args.mechanism)
     fixed: dict[str, object] = {} if args.clearance_at is None else {"clearance_at": tuple(args.clearance_at)}
     if args.parameter == "clearance":
         lo, hi, key = si(args.start or 0.01, "mm"), si(args.stop or 1.0, "mm"), "radial_clearance"
@@ -88,14 +143,27 @@ def main_sweep(argv: Sequence[str] | None = None) -> int:
         hi = entry.speed_range[1] if args.stop is None else si(args.stop, "rpm")
         if args.clearance_mm is not None:
             fixed["radial_clearance"] = si(args.clearance_mm, "mm")
-    if args.points < 1:
-        return usage_error(f"--points must be at least 1 (got {args.points})")
+    if args.points > 1 and not lo < hi:
+        unit = "mm" if args.parameter == "clearance" else "rpm"
+        raise UsageError(
+            f"--start must be below --stop: the {args.parameter} sweep would run from {lo / si(1, unit):g} to "
+            f"{hi / si(1, unit):g} {unit} (give both, or swap them)"
+        )
     values = (np.geomspace if args.log else np.linspace)(lo, hi, args.points)
     make = KeywordFactory(entry.builder, fixed=fixed)
-    try:
-        probed = probe(make, {key: float(values[0])}, args.mechanism)
-    except UsageError as err:
-        return usage_error(str(err))
+    options = sweep_options(args)
+    unit = "mm" if args.parameter == "clearance" else "rpm"
+    probed, _ = (  # the ends of the range: the bounds of `clearance.cli.limits` are monotonic in both
+        probe(
+            make,
+            {key: float(v)},
+            args.mechanism,
+            source=f"--mechanism {args.mechanism} --parameter {args.parameter} {flag} {v / si(1, unit):g}",
+            periods=args.periods,
+            timestep=options.timestep,
+        )
+        for flag, v in (("--start", values[0]), ("--stop", values[-1]))
+    )
     valid = quantities(probed)
     quantity = args.quantity
     if quantity is None:
@@ -104,26 +172,29 @@ def main_sweep(argv: Sequence[str] | None = None) -> int:
         quantity = f"{probed.clearance_joints[0].name}.ex"
     elif quantity not in valid:
         return usage_error(f"--quantity {quantity!r} is not a quantity of {args.mechanism}; choose one of {valid}")
-    out = sweep_out(args, "sweep")
+    from clearance.analysis.figures.analysis_figures import plot_bifurcation
+    from clearance.analysis.sweeps.bifurcation import run_bifurcation
+
     try:
-        diagram = run_bifurcation(
-            values,
-            make,
-            out_dir=out,
-            parameter=key,
-            quantity=quantity,
-            periods=args.periods,
-            sampled=args.sampled,
-            options=sweep_options(args),
-            scheduler_address=args.scheduler,
-            progress=not args.no_progress,
-            stop_after=args.stop_after,
-            max_workers=args.workers,
-        )
-    except ValueError as err:
-        return usage_error(str(err))
-    png = out / "bifurcation.png"
-    plot_bifurcation(diagram, path=png)
+        with folder_lock(out):
+            diagram = run_bifurcation(
+                values,
+                make,
+                out_dir=out,
+                parameter=key,
+                quantity=quantity,
+                periods=args.periods,
+                sampled=args.sampled,
+                options=options,
+                scheduler_address=args.scheduler,
+                progress=not args.no_progress,
+                stop_after=args.stop_after,
+                max_workers=args.workers,
+            )
+            png = out / "bifurcation.png"
+            plot_bifurcation(diagram, path=png)
+    except SchedulerError as err:
+        return usage_error(f"--scheduler {args.scheduler}: {err}")
     counts = {r: diagram.regimes.count(r) for r in dict.fromkeys(diagram.regimes)}
     print(f"{len(diagram.values)}/{args.points} points in {out}; regimes {counts}; figure {png}")
     errors = [e for r, e in zip(diagram.regimes, diagram.errors) if r == "error"]

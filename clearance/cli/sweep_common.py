@@ -1,7 +1,10 @@
-"""What ``clearance sweep`` and ``clearance rank`` share: catalogue look-up, the up-front probe, failures.
+"""What ``clearance sweep`` and ``clearance rank`` share: look-ups, up-front checks, failures, Ctrl-C.
 
-The mechanism of a sweep is built once from the first point before any point is launched, so
-an argument its builder rejects is a usage error (exit 2), not a sweep of error rows.
+The mechanisms of a sweep are built from its first and last points before any point is
+launched, so an argument its builder rejects, or a point outside `clearance.cli.limits`, is a
+usage error (exit 2), not a sweep of error rows; a Dask scheduler without Dask installed is
+refused with the install command before any work; a Ctrl-C ends with one line saying how
+many points are kept (exit 130).
 """
 
 from __future__ import annotations
@@ -12,23 +15,45 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from clearance.builders.catalogue import CatalogueEntry
+from clearance.cli.limits import check_mechanism, check_steps
 from clearance.model import Mechanism
 
 if TYPE_CHECKING:  # the analysis is imported by the commands that sweep, when they run
     from clearance.analysis.sweeps.sweep import MechanismFactory
 
-__all__ = ["UsageError", "catalogue_entry", "probe", "quantities", "report_failures", "usage_error"]
+__all__ = [
+    "INTERRUPTED",
+    "UsageError",
+    "catalogue_entry",
+    "check_scheduler",
+    "interrupted",
+    "probe",
+    "quantities",
+    "report_failures",
+    "usage_error",
+]
+
+INTERRUPTED = 130
+"""Exit status of a command stopped with Ctrl-C (128 + SIGINT, as shells report it)."""
 
 _JOINT_PARTS = ("ex", "ey", "vx", "vy", "e", "force")
 """Parts of a clearance joint that `chaos.quantity_series` samples (``<joint>.<part>``)."""
 
 
+class UsageError(Exception):
+    """A command-line argument the mechanism's builder rejects, or one out of bounds."""
+
+
 def catalogue_entry(name: str) -> CatalogueEntry:
-    """The catalogue entry named ``name``; exits with a usage message naming the choices otherwise."""
+    """The catalogue entry named ``name``.
+
+    Raises:
+        UsageError: no such mechanism (the message names the choices).
+    """
     from clearance.builders import CATALOGUE
 
     if name not in CATALOGUE:
-        raise SystemExit(f"error: unknown mechanism {name!r}; choose one of {sorted(CATALOGUE)}")
+        raise UsageError(f"--mechanism: unknown mechanism {name!r}; choose one of {sorted(CATALOGUE)}")
     return CATALOGUE[name]
 
 
@@ -38,32 +63,72 @@ def usage_error(message: str) -> int:
     return 2
 
 
-class UsageError(Exception):
-    """A command-line argument the mechanism's builder rejects."""
+def interrupted(out: Path) -> int:
+    """Say how many points of the sweep folder ``out`` are kept after a Ctrl-C; return 130."""
+    kept = len(list((out / "points").glob("point_*.json"))) if (out / "points").is_dir() else 0
+    print(f"interrupted; {kept} points kept in {out}, rerun to resume", file=sys.stderr)
+    return INTERRUPTED
 
 
-def probe(make: MechanismFactory, point: Mapping[str, Any], mechanism: str) -> Mechanism:
+def check_scheduler(address: str | None) -> None:
+    """Refuse ``--scheduler`` when Dask is not installed, naming the install command.
+
+    Raises:
+        UsageError: an address was given and ``dask.distributed`` cannot be imported.
+    """
+    if address is None:
+        return
+    from clearance.analysis.sweeps.executor import SchedulerError, require_dask
+
+    try:
+        require_dask()
+    except SchedulerError as err:
+        raise UsageError(f"--scheduler {address}: {err}") from None
+
+
+def probe(
+    make: MechanismFactory,
+    point: Mapping[str, Any],
+    mechanism: str,
+    *,
+    source: str | None = None,
+    periods: float | None = None,
+    timestep: float | None = None,
+) -> Mechanism:
     """Build the mechanism of one point up front, so a wrong argument is a usage error, not N error rows.
 
     Args:
         make: the sweep's mechanism factory (point -> `Mechanism`).
-        point: the first point.
+        point: the point.
         mechanism: the catalogue name, for the message.
+        source: the options that set the point, for a message of `clearance.cli.limits`
+            (default: ``--mechanism <name>``).
+        periods, timestep: drive periods and time step [s] of each run; with both, a run
+            of more than `clearance.cli.limits.MAX_STEPS` steps is refused.
 
     Returns:
         The point's mechanism.
 
     Raises:
-        UsageError: the builder rejects the point's arguments.
+        UsageError: the builder rejects the point's arguments, or the mechanism or its run
+            is outside `clearance.cli.limits`.
     """
+    where = source or f"--mechanism {mechanism} at {dict(point)}"
     try:
-        return make(point)
+        mech = make(point)
     except TypeError as err:
         raise UsageError(
             f"--mechanism {mechanism}: its builder does not take the arguments of this command ({err})"
         ) from None
     except ValueError as err:
-        raise UsageError(f"--mechanism {mechanism} at {point}: {err}") from None
+        raise UsageError(f"{where}: {err}") from None
+    try:
+        check_mechanism(mech, where)
+        if periods is not None and timestep is not None and mech.drive_period is not None:
+            check_steps(periods * mech.drive_period, timestep, f"{where} --periods {periods:g}")
+    except ValueError as err:
+        raise UsageError(str(err)) from None
+    return mech
 
 
 def report_failures(failed: int, total: int, first: str, out: Path) -> int:

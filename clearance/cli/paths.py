@@ -1,0 +1,228 @@
+"""Where a command writes: checked before any work, and locked while it writes.
+
+`check_folder` and `check_file` refuse an output path that cannot be written -- a file where
+a folder is wanted, a folder where a file is wanted, a path under a file, a folder the user
+may not write in, a read-only file system -- with one line naming the option, the path and
+why, before anything is simulated. They probe by creating (and at once removing) a hidden
+temporary entry, so what they report is what the file system does, for any user.
+
+`folder_lock` holds an exclusive lock on ``<folder>/.clearance.lock`` while a command writes
+there, so that two commands never mix their files in one folder: the second is refused with
+the holder's pid, host, start time and command line. A command replaces only the files it
+writes itself and never deletes others; the lock file goes when the lock is released, and a
+folder the command created is removed again when the command stops before writing anything.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import socket
+import sys
+import tempfile
+import time
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+__all__ = ["LOCK_NAME", "FolderBusyError", "check_file", "check_folder", "folder_lock"]
+
+LOCK_NAME = ".clearance.lock"
+"""The lock file a command holds in its output folder while it writes there."""
+
+
+class FolderBusyError(ValueError):
+    """Another command holds the output folder's lock."""
+
+
+def _existing_ancestor(p: Path) -> Path:
+    """The nearest ancestor of ``p`` (or ``p``) that exists."""
+    a = p
+    while not os.path.lexists(a) and a != a.parent:
+        a = a.parent
+    return a
+
+
+def _why(err: OSError) -> str:
+    return err.strerror or type(err).__name__
+
+
+def _probe_folder(folder: Path) -> None:
+    """Create and remove a hidden temporary file in an existing folder (raises OSError)."""
+    fd, tmp = tempfile.mkstemp(prefix=".clearance-probe-", dir=folder)
+    os.close(fd)
+    os.unlink(tmp)
+
+
+def _probe_create(ancestor: Path) -> None:
+    """Create and remove a hidden temporary folder in an existing folder (raises OSError)."""
+    os.rmdir(tempfile.mkdtemp(prefix=".clearance-probe-", dir=ancestor))
+
+
+def check_folder(path: str | os.PathLike[str], option: str = "--out") -> Path:
+    """An output folder that can be created or written in, else a one-line refusal.
+
+    Args:
+        path: the folder given (it need not exist yet; nothing is created here).
+        option: the option that gave it, for the message.
+
+    Returns:
+        The folder as a `Path`.
+
+    Raises:
+        ValueError: an empty path; an existing file; a path under a file; a folder that
+            cannot be written in or created (the message gives the system's reason).
+    """
+    if not str(path):
+        raise ValueError(f"{option}: give a folder (got an empty path)")
+    p = Path(path)
+    try:
+        if p.exists():
+            if not p.is_dir():
+                raise ValueError(f"{option} {p}: is a file, not a folder; give a folder to write the outputs in")
+            try:
+                _probe_folder(p)
+            except OSError as err:
+                raise ValueError(f"{option} {p}: cannot write in this folder ({_why(err)})") from None
+            return p
+        a = _existing_ancestor(p)
+        if not a.is_dir():
+            raise ValueError(f"{option} {p}: {a} is a file, not a folder, so no folder can be made under it")
+        try:
+            _probe_create(a)
+        except OSError as err:
+            raise ValueError(f"{option} {p}: cannot create a folder in {a} ({_why(err)})") from None
+    except OSError as err:  # a path the system refuses to look at (too long, a loop, no access)
+        raise ValueError(f"{option} {p}: {_why(err)}") from None
+    return p
+
+
+def check_file(path: str | os.PathLike[str], option: str, *, example: str = "out.xml") -> Path:
+    """An output file that can be written (atomically, beside itself), else a one-line refusal.
+
+    Args:
+        path: the file given (it need not exist; missing parent folders are created later).
+        option: the option that gave it, for the message.
+        example: a file name for the message when a folder was given.
+
+    Returns:
+        The file as a `Path`.
+
+    Raises:
+        ValueError: an empty path; an existing folder; a path under a file; a folder that
+            cannot be written in or created.
+    """
+    if not str(path):
+        raise ValueError(f"{option}: give a file path (got an empty path)")
+    p = Path(path)
+    try:
+        if p.is_dir():
+            raise ValueError(f"{option} {p}: is a folder; give a file path (e.g. {p / example})")
+        parent = p.parent
+        if parent.exists():
+            if not parent.is_dir():
+                raise ValueError(f"{option} {p}: {parent} is a file, not a folder")
+            try:
+                _probe_folder(parent)
+            except OSError as err:
+                raise ValueError(f"{option} {p}: cannot write in {parent} ({_why(err)})") from None
+            return p
+        a = _existing_ancestor(parent)
+        if not a.is_dir():
+            raise ValueError(f"{option} {p}: {a} is a file, not a folder, so no folder can be made under it")
+        try:
+            _probe_create(a)
+        except OSError as err:
+            raise ValueError(f"{option} {p}: cannot create a folder in {a} ({_why(err)})") from None
+    except OSError as err:
+        raise ValueError(f"{option} {p}: {_why(err)}") from None
+    return p
+
+
+def _holder_text(fd: int) -> str:
+    try:
+        data = json.loads(os.pread(fd, 4096, 0).decode("utf-8"))
+        started = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(float(data["started"])))
+        return f"pid {data['pid']} on {data['host']}, started {started}: {data['command']}"
+    except (OSError, ValueError, KeyError, TypeError):
+        return "a command that is just starting"
+
+
+def _open_locked(lock: Path, folder: Path, option: str) -> int:
+    """Open ``lock`` and take its exclusive lock; the fd, or `FolderBusyError`."""
+    import fcntl
+
+    while True:
+        fd = os.open(lock, os.O_RDWR | os.O_CREAT, 0o644)
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            holder = _holder_text(fd)
+            os.close(fd)
+            raise FolderBusyError(
+                f"{option} {folder}: another clearance command is writing there ({holder}); wait for it to "
+                f"finish or give another {option}"
+            ) from None
+        # the holder before us may have removed the file after we opened it: lock the one on disk
+        try:
+            same = os.fstat(fd).st_ino == os.stat(lock).st_ino
+        except FileNotFoundError:
+            same = False
+        if same:
+            return fd
+        os.close(fd)
+
+
+@contextmanager
+def folder_lock(folder: Path, option: str = "--out") -> Iterator[Path]:
+    """Create ``folder`` if needed and hold its lock for the ``with`` block.
+
+    Args:
+        folder: the output folder (checked with `check_folder` first).
+        option: the option that gave it, for the message.
+
+    Yields:
+        The folder.
+
+    Raises:
+        FolderBusyError: another command holds the lock (a `ValueError`); nothing was
+            written or created.
+    """
+    missing = []
+    a = folder
+    while not a.exists() and a != a.parent:
+        missing.append(a)
+        a = a.parent
+    folder.mkdir(parents=True, exist_ok=True)
+    lock = folder / LOCK_NAME
+    try:
+        fd = _open_locked(lock, folder, option)
+    except BaseException:
+        _remove_empty(missing)
+        raise
+    holder = {
+        "pid": os.getpid(),
+        "host": socket.gethostname(),
+        "started": time.time(),
+        "command": " ".join([Path(sys.argv[0]).name, *sys.argv[1:]]) if sys.argv else "?",
+    }
+    os.ftruncate(fd, 0)
+    os.pwrite(fd, json.dumps(holder).encode("utf-8"), 0)
+    ok = False
+    try:
+        yield folder
+        ok = True
+    finally:
+        lock.unlink(missing_ok=True)  # while still held: a later command creates a new one
+        os.close(fd)
+        if not ok:
+            _remove_empty(missing)
+
+
+def _remove_empty(created: list[Path]) -> None:
+    """Remove the folders this command created (deepest first) if nothing was written in them."""
+    for d in created:
+        try:
+            d.rmdir()
+        except OSError:
+            return
