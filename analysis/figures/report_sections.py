@@ -79,7 +79,9 @@ def section_points(
         (k (K,) integers, points (K, len(names))).
     """
     ts, pts = poincare_from_result(result, names, period=period)
-    keep = ts >= result.times[0] + skip
+    # a millionth of a period of slack: t = T ends a start-up window of one period whether T
+    # comes from the mechanism or from the recorded drive speed
+    keep = ts >= result.times[0] + skip - 1e-6 * period
     k = np.rint((ts[keep] - result.times[0]) / period).astype(int)
     return k, pts[keep]
 
