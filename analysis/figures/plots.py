@@ -162,7 +162,10 @@ def plot_response(
     drawn[0][0].legend(loc="upper right", fontsize=8)
     drawn[-1][0].set_xlabel("time [ms]")
     cl = ", ".join(result.joints) or "none"
-    scale_note = "; y-scale of the steady state" if startup > 0 else ""
+    scale_note = ""
+    if startup > 0:
+        steady = result.times[-1] > result.times[0] + startup
+        scale_note = "; y-scale of the steady state" if steady else "; the whole run is its start-up window"
     fig.suptitle(f"{result.metadata.get('mechanism', '')}: {output} (clearance at {cl}){scale_note}", fontsize=11)
     if path is not None:
         save_png(fig, path)

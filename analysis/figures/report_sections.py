@@ -174,7 +174,8 @@ def contact_section(result: SimulationResult, window: Window, out: Path) -> list
     by_part = {label: [contact_modes(result, j, **kw) for j in joints] for label, sel, kw in parts if sel.any()}
     figures.plot_contact_modes(
         by_part,
-        title=f"{result.metadata.get('mechanism', '')}: share of time in each contact mode, start-up and steady state",
+        title=f"{result.metadata.get('mechanism', '')}: share of time in each contact mode, "
+        + ", ".join(label.split(",")[0].split(":")[0] for label in by_part),
         path=out / "contact_modes.png",
     )
     head, rule, columns = ["| statistic |"], ["|---|"], []
