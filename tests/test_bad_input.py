@@ -32,6 +32,7 @@ FAST_GUARDS = {
     "clearance.analysis.sweeps.bifurcation.run_bifurcation": "run_bifurcation",
     "clearance.analysis.sweeps.criticality.run_criticality": "run_criticality",
     "clearance.contact_calibration.store.calibrate_joint": "calibrate_joint",
+    "clearance.retrofit.retrofit": "retrofit",
 }
 """Everything that does work, by dotted path: a refused command must reach none of it."""
 
@@ -44,6 +45,9 @@ SCENARIOS = {
     "fast.toml": '[mechanism]\nbuilder = "slider_crank"\ncrank_speed_rpm = 1e9\n',
     "thin.toml": '[mechanism]\nbuilder = "slider_crank"\nbearing_radius_mm = 0.5\nclearance_mm = 0.49\n',
     "ok.toml": '[mechanism]\nbuilder = "slider_crank"\n',
+    "arm.xml": '<mujoco><worldbody><body name="arm"><joint name="elbow" axis="0 0 1"/>'
+    '<geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01"/></body></worldbody>'
+    '<actuator><motor joint="elbow"/></actuator></mujoco>',
 }
 
 RPM_CAP = "at most 60,000"
@@ -269,6 +273,47 @@ BATTERY: list[tuple[str, list[str], list[str]]] = [
     ("calibrate-n-speeds-alone", ["calibrate", "--n-speeds", "3"], ["--n-speeds needs --speeds"]),
     ("calibrate-no-clearance-joint", ["calibrate", "--clearance-at"], ["no clearance joint"]),
     ("calibrate-segments-text", ["calibrate", "--segments", "x"], ["--segments", "whole number"]),
+    # retrofit of a user's model
+    (
+        "retrofit-out-is-a-file",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow", "--out", "{file}"],
+        ["--out {file}", "is a file"],
+    ),
+    (
+        "retrofit-out-under-a-file",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow", "--out", "{file}/r"],
+        ["--out {file}/r", "is a file"],
+    ),
+    (
+        "retrofit-out-system-folder",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow", "--out", "/sys/r"],
+        ["--out /sys/r", "cannot create"],
+    ),
+    (
+        "retrofit-thin-journal",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow:clearance_mm=9.99", "--out", "{tmp}/r"],
+        ["--joint elbow:clearance_mm=9.99", "journal of radius 0.01 mm", "bearing of radius 10 mm"],
+    ),
+    (
+        "retrofit-segments-100000",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow", "--out", "{tmp}/r", "--segments", "100000"],
+        ["--segments", "at most 1,024"],
+    ),
+    (
+        "retrofit-timestep-huge",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow", "--out", "{tmp}/r", "--timestep-us", "1e9"],
+        ["--timestep-us", "at most 10,000"],
+    ),
+    (
+        "retrofit-sizing-huge",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow", "--out", "{tmp}/r", "--sizing-duration-s", "1e9"],
+        ["--sizing-duration-s 1e+09", "time steps"],
+    ),
+    (
+        "retrofit-model-missing",
+        ["retrofit", "{tmp}/none.xml", "--joint", "elbow", "--out", "{tmp}/r"],
+        ["none.xml does not exist"],
+    ),
     # the command itself
     ("no-command", [], ["required: command"]),
     ("unknown-command", ["simulate"], ["invalid choice: 'simulate'"]),
@@ -470,6 +515,10 @@ def test_a_folder_in_use_is_refused_naming_the_holder(tmp_path, capsys, no_work)
     assert rc == 2 and "Traceback" not in err
     assert f"--out {out}: another clearance command is writing there (pid {os.getpid()} on " in err
     assert list(out.iterdir()) == []  # the refused command wrote nothing, and the lock went with its holder
+    # a lock file left by a killed command holds no lock (the system releases it with the process)
+    (out / ".clearance.lock").write_text('{"pid": 1, "host": "gone", "started": 0, "command": "killed"}')
+    with folder_lock(out):
+        assert _holder_pid(out / ".clearance.lock") == os.getpid()
 
 
 def _command(*args: str) -> list[str]:

@@ -340,7 +340,7 @@ def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str,
         except ValueError as err:
             raise ValueError(
                 f"{path} is unreadable ({err}); it records which sweep {out} holds, so its points cannot be "
-                "reused safely: delete that folder to start over, or give another out_dir"
+                "reused safely: delete that folder to start over, or use another folder"
             ) from None
         if old != manifest:
             old_settings = old.get("settings", {})

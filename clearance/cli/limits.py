@@ -13,7 +13,7 @@ from __future__ import annotations
 import math
 
 from clearance.checks import MAX_DRIVE_RPM, MAX_DRIVE_SPEED
-from clearance.model import DriveKind, Mechanism
+from clearance.model import Clearance, DriveKind, Mechanism
 
 __all__ = [
     "MAX_DRIVE_RPM",
@@ -22,6 +22,7 @@ __all__ = [
     "MAX_STEPS",
     "MIN_CLEARANCE",
     "MIN_JOURNAL_RATIO",
+    "check_clearance",
     "check_mechanism",
     "check_steps",
 ]
@@ -78,21 +79,34 @@ def check_mechanism(mech: Mechanism, source: str) -> None:
                 "the journals are pressed deeper than their clearance and the runs diverge)"
             )
     for j in mech.clearance_joints:
-        c = j.require_clearance()
-        if c.radial_clearance < MIN_CLEARANCE:
-            raise ValueError(
-                f"{source}: joint '{j.name}': radial clearance {c.radial_clearance * 1e3:.6g} mm is below the "
-                f"smallest accepted, {MIN_CLEARANCE * 1e3:g} mm (1 µm)"
-            )
-        ratio = c.journal_radius / c.bearing_radius
-        if ratio < MIN_JOURNAL_RATIO:
-            raise ValueError(
-                f"{source}: joint '{j.name}': a radial clearance of {c.radial_clearance * 1e3:.6g} mm leaves a "
-                f"journal of radius {c.journal_radius * 1e3:.6g} mm in a bearing of radius "
-                f"{c.bearing_radius * 1e3:.6g} mm ({ratio:.2%} of it); the contact laws are for journals of at "
-                f"least {MIN_JOURNAL_RATIO:.0%} of the bearing radius (a radial clearance of at most "
-                f"{(1 - MIN_JOURNAL_RATIO) * c.bearing_radius * 1e3:.6g} mm here)"
-            )
+        check_clearance(f"joint '{j.name}'", j.require_clearance(), source)
+
+
+def check_clearance(joint: str, c: Clearance, source: str) -> None:
+    """Refuse a clearance below `MIN_CLEARANCE` or a journal below `MIN_JOURNAL_RATIO` of its bearing.
+
+    Args:
+        joint: the joint, for the message (``"joint 'rod_slider'"``).
+        c: its clearance.
+        source: where the numbers came from, for the message.
+
+    Raises:
+        ValueError: naming the joint, both radii and the bound.
+    """
+    if c.radial_clearance < MIN_CLEARANCE:
+        raise ValueError(
+            f"{source}: {joint}: radial clearance {c.radial_clearance * 1e3:.6g} mm is below the "
+            f"smallest accepted, {MIN_CLEARANCE * 1e3:g} mm (1 µm)"
+        )
+    ratio = c.journal_radius / c.bearing_radius
+    if ratio < MIN_JOURNAL_RATIO:
+        raise ValueError(
+            f"{source}: {joint}: a radial clearance of {c.radial_clearance * 1e3:.6g} mm leaves a "
+            f"journal of radius {c.journal_radius * 1e3:.6g} mm in a bearing of radius "
+            f"{c.bearing_radius * 1e3:.6g} mm ({ratio:.2%} of it); the contact laws are for journals of at "
+            f"least {MIN_JOURNAL_RATIO:.0%} of the bearing radius (a radial clearance of at most "
+            f"{(1 - MIN_JOURNAL_RATIO) * c.bearing_radius * 1e3:.6g} mm here)"
+        )
 
 
 def check_steps(duration: float, step: float, source: str, *, what: str = "time steps") -> None:

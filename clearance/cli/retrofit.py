@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import argparse
 import math
-import os
 from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from clearance.cli.options import positive, si
+from clearance.cli.limits import check_clearance, check_steps
+from clearance.cli.options import positive, segments_option, si, timestep_option
+from clearance.cli.paths import check_folder, folder_lock
 from clearance.model import ContactLaw, Material
 from clearance.units import UNITS
 
@@ -131,12 +132,14 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     num.add_argument(
         "--timestep-us",
-        type=positive(float, "--timestep-us"),
+        type=timestep_option(),
         default=None,
         help="time step [µs] (default: the largest 1/2/5 x 10^k with omega*h <= 0.2 at every bearing, "
         "at most the model's own)",
     )
-    num.add_argument("--segments", type=int, default=None, help="ring segments per bearing (default: the ripple rule)")
+    num.add_argument(
+        "--segments", type=segments_option(), default=None, help="ring segments per bearing (default: the ripple rule)"
+    )
     num.add_argument("--journal-geom", default="sphere", choices=("sphere", "capsule", "cylinder"))
     num.add_argument("--segment-geom", default="sphere", choices=("sphere", "capsule", "box", "cylinder"))
     motion = p.add_argument_group("sizing motion (the unmodified model under a sinusoid on every actuator)")
@@ -227,17 +230,10 @@ def plays_from_args(args: argparse.Namespace) -> dict[str, RadialPlay]:
             friction=v["friction"],
             law=ContactLaw(args.law),
         )
+        check_clearance(where, clearance, f"--joint {text}")
         eccentricity = (si(v["eccentricity_x_mm"], "mm"), si(v["eccentricity_y_mm"], "mm"))
         plays[name] = RadialPlay(clearance, eccentricity)
     return plays
-
-
-def _check_out(out: Path) -> None:
-    if out.exists() and not out.is_dir():
-        raise ValueError(f"--out {out}: exists and is not a folder")
-    parent = out if out.exists() else next((p for p in out.parents if p.exists()), Path("."))
-    if not os.access(parent, os.W_OK):
-        raise ValueError(f"--out {out}: cannot write in {parent}")
 
 
 def _command_line(args: argparse.Namespace) -> str:
@@ -284,8 +280,7 @@ def command(args: argparse.Namespace) -> int:
         sizing_duration=args.sizing_duration_s,
         measure_speed=not args.no_speed,
     )
-    out = Path(args.out)
-    _check_out(out)
+    out = check_folder(args.out, "--out")
     path = Path(args.model)
     if not path.is_file():
         raise ValueError(f"model file {path} does not exist" if not path.exists() else f"{path} is not a file")
@@ -293,11 +288,15 @@ def command(args: argparse.Namespace) -> int:
         spec = mujoco.MjSpec.from_file(str(path))
     except ValueError as err:
         raise ValueError(f"model file {path} cannot be read by MuJoCo: {err}") from None
-    try:
-        result = retrofit(spec, plays, options)
-    except ValueError as err:
-        raise ValueError(f"{path}: {err}") from None
-    paths = write_retrofit(result, out, source_dir=path.resolve().parent, source=str(path), command=_command_line(args))
+    check_steps(args.sizing_duration_s, spec.option.timestep, f"--sizing-duration-s {args.sizing_duration_s:g}")
+    with folder_lock(out):
+        try:
+            result = retrofit(spec, plays, options)
+        except ValueError as err:
+            raise ValueError(f"{path}: {err}") from None
+        paths = write_retrofit(
+            result, out, source_dir=path.resolve().parent, source=str(path), command=_command_line(args)
+        )
     for h in result.hinges.values():
         s = h.sizing
         print(
