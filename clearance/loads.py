@@ -41,7 +41,7 @@ def generalized_inertial_forces(mechanism: Mechanism, q: np.ndarray, qd: np.ndar
 
 
 def joint_reaction_vectors(
-    mechanism: Mechanism, times: np.ndarray
+    mechanism: Mechanism, times: np.ndarray, *, kinematics: KinematicsResult | None = None
 ) -> tuple[dict[str, np.ndarray], dict[str, np.ndarray]]:
     """Reaction forces of the ideal twin at every joint and drive.
 
@@ -50,6 +50,8 @@ def joint_reaction_vectors(
     Args:
         mechanism: the mechanism (its ideal twin is solved).
         times: (n,) times [s].
+        kinematics: `solve_kinematics` of the mechanism (or of its ideal twin: the same) at
+            ``times``, when the caller has it already; solved here otherwise.
 
     Returns:
         (pairs, drives): joint name -> (n, 2) multipliers of the joint's two constraint
@@ -59,16 +61,16 @@ def joint_reaction_vectors(
     Raises:
         AssemblyError: the mechanism cannot be assembled at some time.
     """
-    _, pairs, drives = _multipliers(mechanism, times)
+    _, pairs, drives = _multipliers(mechanism, times, kinematics)
     return pairs, drives
 
 
 def _multipliers(
-    mechanism: Mechanism, times: np.ndarray
+    mechanism: Mechanism, times: np.ndarray, kinematics: KinematicsResult | None = None
 ) -> tuple[KinematicsResult, dict[str, np.ndarray], dict[str, np.ndarray]]:
     """(ideal kinematics, pair multipliers, drive multipliers): see `joint_reaction_vectors`."""
     ideal = mechanism.ideal_twin()
-    kin = solve_kinematics(ideal, times)
+    kin = kinematics if kinematics is not None else solve_kinematics(ideal, times)
     cs = ConstraintSystem(ideal)
     inert = generalized_inertial_forces(ideal, kin.q, kin.qd, kin.qdd)
     lam = np.linalg.solve(np.swapaxes(cs.jacobian(kin.q), -1, -2), inert[..., None])[..., 0]

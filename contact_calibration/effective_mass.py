@@ -221,7 +221,7 @@ def cycle_effective_mass(
     data = mujoco.MjData(model)
     data.qpos[:] = model.qpos0
     out = {j: np.zeros(n_poses) for j in built.rings}
-    loads = joint_reaction_vectors(mechanism, times)[0] if along_load else {}
+    loads = joint_reaction_vectors(mechanism, times, kinematics=kin)[0] if along_load else {}
     sizes = {j: np.hypot(v[:, 0], v[:, 1]) for j, v in loads.items()}
     light = {j: LIGHT_LOAD * float(np.max(v)) for j, v in sizes.items()}
     for i, q in enumerate(kin.q):
