@@ -219,7 +219,11 @@ def size_play(
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
             segments = choose_segments(clearance.bearing_radius, c, dtyp, ripple_limit=ripple_limit, flat=flat)
-        notes = [str(w.message) for w in caught]
+        # the rule speaks to a mechanism's user; a retrofit's chooses the count with --segments
+        notes = [
+            str(w.message).replace("give ModelOptions(segments=...)", "give --segments (RetrofitOptions(segments=...))")
+            for w in caught
+        ]
     sizing = PlaySizing(
         K, fmed, fmax, dtyp, v, m, (mass.minimum, mass.maximum), lim, segments, contact_omega(K, lim, m)
     )
