@@ -59,6 +59,8 @@ BATTERY: list[tuple[str, list[str], list[str]]] = [
     ("run-out-is-a-file", ["run", "--out", "{file}"], ["--out {file}", "is a file, not a folder"]),
     ("run-out-under-a-file", ["run", "--out", "{file}/sub"], ["--out {file}/sub", "{file} is a file"]),
     ("run-out-empty", ["run", "--out", ""], ["--out", "empty path"]),
+    ("run-out-broken-link", ["run", "--out", "{tmp}/broken"], ["--out {tmp}/broken", "is a link to", "does not exist"]),
+    ("mjcf-out-broken-link", ["mjcf", "--out", "{tmp}/broken"], ["--out {tmp}/broken", "is a link to"]),
     ("run-out-not-writable", ["run", "--out", "{ro}"], ["--out {ro}", "cannot write in this folder"]),
     ("run-out-in-not-writable", ["run", "--out", "{ro}/new"], ["--out {ro}/new", "cannot create a folder in {ro}"]),
     ("run-out-system-folder", ["run", "--out", "/sys/clearance-out"], ["--out /sys/clearance-out", "/sys"]),
@@ -253,7 +255,7 @@ BATTERY: list[tuple[str, list[str], list[str]]] = [
     ("rank-stop-after-negative", ["rank", "--stop-after", "-1"], ["--stop-after", "> 0"]),
     ("rank-mechanism-unknown", ["rank", "--mechanism", "nosuch"], ["--mechanism", "invalid choice"]),
     # the benchmark
-    ("bench-workers-0", ["bench", "--workers", "0"], ["--workers", "> 0"]),
+    ("bench-workers-0", ["bench", "--workers", "0"], ["--workers must be >= 1"]),
     ("bench-scenario-unknown", ["bench", "--scenarios", "nosuch"], ["unknown scenario", "slider_crank"]),
     ("bench-settings-match-nothing", ["bench", "--settings", "zzz*"], ["--settings zzz*", "matches no setting"]),
     (
@@ -393,6 +395,7 @@ def test_bad_input_battery(argv, words, tmp_path, monkeypatch, capsys, no_work):
     monkeypatch.chdir(tmp_path)  # default output folders land here, and are checked not to appear
     (tmp_path / "afile").write_text("not a folder")
     (tmp_path / "adir").mkdir()
+    (tmp_path / "broken").symlink_to(tmp_path / "nowhere")
     for name, text in SCENARIOS.items():
         (tmp_path / name).write_text(text)
     (tmp_path / "binary.toml").write_bytes(b"\xff\xfe\x00[mechanism]")
@@ -480,14 +483,22 @@ def test_scenario_builder_sizes_out_of_range_are_refused_naming_the_key():
     assert tried > 100  # every builder's arguments were tried (12 builders)
 
 
-def test_the_speed_cap_still_runs(tmp_path, capsys):
-    """The stated cap is one the default run completes at (0.5 ms = half a revolution at 60,000 rpm)."""
+def test_at_the_speed_cap_a_run_completes_and_the_time_step_remedy_works(tmp_path, capsys):
+    """The stated cap is a speed the default run completes at, and where a time step is refused
+    as too large, the step the message gives (halved, as it says to stay well below) runs."""
+    import re
+
     out = tmp_path / "out"
-    rc, stdout, err = _call(
-        ["run", "--rpm", "60000", "--duration-ms", "0.5", "--out", str(out), "--no-progress"], capsys
-    )
+    # 0.5 ms: half a revolution at 60,000 rpm, through the first impact
+    rc, _, err = _call(["run", "--rpm", "60000", "--duration-ms", "0.5", "--out", str(out), "--no-progress"], capsys)
     assert rc == 0, err
-    assert (out / "summary.csv").exists()
+    ring = ["run", "--rpm", "60000", "--contact-mode", "nominal", "--duration-ms", "1", "--no-progress"]
+    rc, _, err = _call([*ring, "--timestep-us", "20", "--out", str(tmp_path / "refused")], capsys)
+    below = re.search(r"Use a time step below ([0-9.e+-]+) s", err)
+    assert rc == 2 and below, err
+    step_us = float(below.group(1)) * 1e6 / 2
+    rc, _, err = _call([*ring, "--timestep-us", f"{step_us:g}", "--out", str(tmp_path / "remedy")], capsys)
+    assert rc == 0, err
 
 
 def test_run_keeps_other_files_and_says_where_the_recording_went(tmp_path, capsys):

@@ -15,7 +15,6 @@ from collections.abc import Sequence
 
 from clearance.bench.scenarios import default_scenarios, write_report
 from clearance.bench.speed_error import run_speed_error
-from clearance.cli.options import positive
 from clearance.cli.paths import FolderBusyError, check_folder, folder_lock
 from clearance.cli.sweep_common import INTERRUPTED
 
@@ -42,12 +41,7 @@ def bench_parser() -> argparse.ArgumentParser:
         help="only the settings whose key matches one of these shell patterns (e.g. 'exact_*' "
         "'calibrated_h2us_Nrule_*'; keys as in the output folder's file names); the reference always runs",
     )
-    p.add_argument(
-        "--workers",
-        type=positive(int, "--workers"),
-        default=None,
-        help="processes for the accuracy runs (default: CPU count)",
-    )
+    p.add_argument("--workers", type=int, default=None, help="processes for the accuracy runs (default: CPU count)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")
     return p
 
@@ -63,6 +57,9 @@ def main_bench(argv: Sequence[str] | None = None) -> int:
     the finished runs are kept).
     """
     args = bench_parser().parse_args(argv)
+    if args.workers is not None and args.workers < 1:
+        print(f"error: --workers must be >= 1 (got {args.workers})", file=sys.stderr)
+        return 2
     try:
         out = check_folder(args.out, "--out")
     except ValueError as err:

@@ -47,6 +47,12 @@ def _why(err: OSError) -> str:
     return err.strerror or type(err).__name__
 
 
+def _refuse_broken_link(p: Path, option: str) -> None:
+    """Refuse a link that leads nowhere (its target is missing, or links loop)."""
+    if p.is_symlink() and not p.exists():
+        raise ValueError(f"{option} {p}: is a link to {os.readlink(p)}, which does not exist (or loops)")
+
+
 def _probe_folder(folder: Path) -> None:
     """Create and remove a hidden temporary file in an existing folder (raises OSError)."""
     fd, tmp = tempfile.mkstemp(prefix=".clearance-probe-", dir=folder)
@@ -77,6 +83,7 @@ def check_folder(path: str | os.PathLike[str], option: str = "--out") -> Path:
         raise ValueError(f"{option}: give a folder (got an empty path)")
     p = Path(path)
     try:
+        _refuse_broken_link(p, option)
         if p.exists():
             if not p.is_dir():
                 raise ValueError(f"{option} {p}: is a file, not a folder; give a folder to write the outputs in")
@@ -116,6 +123,7 @@ def check_file(path: str | os.PathLike[str], option: str, *, example: str = "out
         raise ValueError(f"{option}: give a file path (got an empty path)")
     p = Path(path)
     try:
+        _refuse_broken_link(p, option)
         if p.is_dir():
             raise ValueError(f"{option} {p}: is a folder; give a file path (e.g. {p / example})")
         parent = p.parent
@@ -187,13 +195,20 @@ def folder_lock(folder: Path, option: str = "--out") -> Iterator[Path]:
     Raises:
         FolderBusyError: another command holds the lock (a `ValueError`); nothing was
             written or created.
+
+    Where the system has no ``fcntl`` (Windows), the folder is created and not locked.
     """
+    import importlib.util
+
     missing = []
     a = folder
     while not a.exists() and a != a.parent:
         missing.append(a)
         a = a.parent
     folder.mkdir(parents=True, exist_ok=True)
+    if importlib.util.find_spec("fcntl") is None:
+        yield folder
+        return
     lock = folder / LOCK_NAME
     try:
         fd = _open_locked(lock, folder, option)
