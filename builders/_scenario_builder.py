@@ -7,9 +7,10 @@ its name where the argument has one (``crank_speed_rpm``, ``radial_clearance_mm`
 (youngs_modulus_gpa, poisson_ratio), a ``*_motion`` argument a table (speed_rad_per_s,
 harmonics_rad, period_s).
 
-A number with a unit must lie in the range `RANGES` gives its quantity (or be 0, which the
-builder then accepts or refuses): a crank of 1e-300 m or a rod of 1e300 m is refused here,
-naming file, line, key and range, instead of dividing by zero or overflowing in the builder.
+A number with a unit must lie in the range `clearance.builders._toml_reader.RANGES` gives its
+quantity (or be 0, which the builder then accepts or refuses): a crank of 1e-300 m or a rod
+of 1e300 m is refused here, naming file, line, key and range, instead of dividing by zero or
+overflowing in the builder.
 """
 
 from __future__ import annotations
@@ -19,48 +20,13 @@ import math
 from typing import Any
 
 from clearance.builders._toml_reader import Table
-from clearance.checks import MAX_DRIVE_SPEED
 from clearance.kinematics import AssemblyError
 from clearance.model import ContactLaw, Material, Mechanism, MotionLaw
 from clearance.units import UNITS, describe_units, quantity_of
 
-__all__ = ["RANGES", "from_builder"]
+__all__ = ["from_builder"]
 
 _ALIASES = {"clearance": "radial_clearance"}
-
-RANGES: dict[str, tuple[float, float]] = {
-    "length": (1e-6, 1e3),
-    "mass": (1e-6, 1e6),
-    "inertia": (1e-15, 1e6),
-    "linear_density": (1e-6, 1e6),
-    "angular_speed": (1e-3, MAX_DRIVE_SPEED),
-    "angle": (0.0, 1e4),
-    "acceleration": (0.0, 1e4),
-}
-"""Quantity -> (smallest, largest) magnitude [SI] of a builder argument other than 0.
-
-Lengths from 1 µm to 1 km, masses from 1 mg to 1000 t, drive speeds from 0.01 rpm to
-`clearance.checks.MAX_DRIVE_RPM`; angles and accelerations up to 10^4 (rad, m/s^2). A
-coordinate pair (a pivot) is held to the largest magnitude only.
-"""
-
-
-def _check_range(t: Table, key: str, quantity: str, factor: float, values: tuple[float, ...]) -> None:
-    """Refuse values outside `RANGES` of their quantity (in the key's own unit in the message)."""
-    if quantity not in RANGES:
-        return
-    lo, hi = RANGES[quantity]
-    unit = next((u for u in sorted(UNITS[quantity], key=len, reverse=True) if key.endswith("_" + u)), "")
-    single = len(values) == 1
-    for v in values:
-        m = abs(v)
-        if (single and m != 0 and m < lo) or m > hi:
-            expected = (
-                f"0 or between {lo / factor:g} and {hi / factor:g} {unit} in magnitude"
-                if single and lo > 0
-                else f"at most {hi / factor:g} {unit} in magnitude"
-            )
-            raise t.error(key, f"must be {expected} (got {v / factor:g} {unit})")
 
 
 def _match(key: str, params: list[str]) -> tuple[str, float] | None:
@@ -103,11 +69,11 @@ def _convert(t: Table, key: str, param: str, factor: float, value: Any) -> Any:
     if q is not None:
         if isinstance(value, list):
             pair = t.convert_pair(key, value, factor)
-            _check_range(t, key, q, factor, pair)
+            t.check_range(key, q, factor, pair)
             return pair
         if not isinstance(value, (int, float)) or isinstance(value, bool) or not math.isfinite(value):
             raise t.error(key, f"must be a finite number (got {value!r})")
-        _check_range(t, key, q, factor, (value * factor,))
+        t.check_range(key, q, factor, (value * factor,))
         return value * factor
     if param == "law":
         try:

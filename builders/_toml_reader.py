@@ -13,9 +13,31 @@ import re
 from collections.abc import Sequence
 from typing import Any, Literal, TypeVar, overload
 
+from clearance.checks import MAX_DRIVE_SPEED
 from clearance.units import UNITS, describe_units
 
-__all__ = ["ScenarioError", "Locator", "Table"]
+__all__ = ["RANGES", "ScenarioError", "Locator", "Table"]
+
+RANGES: dict[str, tuple[float, float]] = {
+    "length": (1e-6, 1e3),
+    "mass": (1e-6, 1e6),
+    "inertia": (1e-15, 1e6),
+    "linear_density": (1e-6, 1e6),
+    "angular_speed": (1e-3, MAX_DRIVE_SPEED),
+    "angle": (0.0, 1e4),
+    "acceleration": (0.0, 1e4),
+    "time": (1e-6, 1e6),
+    "pressure": (1e3, 1e13),
+    "torque": (0.0, 1e7),
+}
+"""Quantity -> (smallest, largest) magnitude [SI] of a scenario number other than 0.
+
+Lengths from 1 µm to 1 km, masses from 1 mg to 1000 t, drive speeds from 0.01 rpm to
+`clearance.checks.MAX_DRIVE_RPM`, Young's moduli from 1 kPa (a gel) to 10 TPa (beyond
+diamond); angles and accelerations up to 10^4 (rad, m/s^2). 0 is left to the mechanism's own
+checks (a ground link has no mass). A coordinate pair (a point, a pivot, a centre of mass)
+is held to the largest magnitude only: a coordinate may be 0 or tiny.
+"""
 
 
 class ScenarioError(ValueError):
@@ -174,6 +196,7 @@ class Table:
         v = self.data[key]
         if not _is_number(v):
             raise self.error(key, f"must be a finite number (got {v!r})")
+        self.check_range(key, quantity, factor, (v * factor,))
         return v * factor if factor != 1.0 else v
 
     def pair(self, base: str, quantity: str, default: tuple[float, float] | None = None) -> tuple[float, float]:
@@ -182,7 +205,30 @@ class Table:
         if hit is None:
             return self._default(default, f"'{base}_<unit>' ({describe_units(base, quantity)})")
         key, factor = hit
-        return self.convert_pair(key, self.data[key], factor)
+        pair = self.convert_pair(key, self.data[key], factor)
+        self.check_range(key, quantity, factor, pair)
+        return pair
+
+    def check_range(
+        self, key: str, quantity: str, factor: float, values: tuple[float, ...], unit: str | None = None
+    ) -> None:
+        """Refuse SI values of ``key`` outside `RANGES` of their quantity (one value: the range;
+        a pair: its largest magnitude); the message gives ``unit``, by default the key's own."""
+        if quantity not in RANGES:
+            return
+        lo, hi = RANGES[quantity]
+        if unit is None:
+            unit = next((u for u in sorted(UNITS[quantity], key=len, reverse=True) if key.endswith("_" + u)), "")
+        single = len(values) == 1
+        for v in values:
+            m = abs(v)
+            if (single and m != 0 and m < lo) or m > hi:
+                expected = (
+                    f"0 or between {lo / factor:g} and {hi / factor:g} {unit} in magnitude"
+                    if single and lo > 0
+                    else f"at most {hi / factor:g} {unit} in magnitude"
+                )
+                raise self.error(key, f"must be {expected} (got {v / factor:g} {unit})")
 
     def convert_pair(self, key: str, v: Any, factor: float) -> tuple[float, float]:
         """Check and convert an (x, y) value read from ``key``."""

@@ -150,7 +150,11 @@ def _read_link(t: Table, ground: str) -> Link:
         raise t.error("points", "needs a unit in its name: use points_m or points_mm")
     pts_t = t.sub("points_m", "points") if t.has("points_m") else t.sub("points_mm", "points")
     scale = 1e-3 if t.has("points_mm") else 1.0
-    points = {} if pts_t is None else {k: pts_t.convert_pair(k, v, scale) for k, v in pts_t.data.items()}
+    points = {}
+    if pts_t is not None:
+        for k, v in pts_t.data.items():
+            points[k] = pts_t.convert_pair(k, v, scale)
+            pts_t.check_range(k, "length", scale, points[k], unit="mm" if scale != 1.0 else "m")
     lk_name = t.text("name")
     pos = t.pair("position_guess", "length", (0.0, 0.0))
     link: Link = _wrap(

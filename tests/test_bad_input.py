@@ -11,6 +11,7 @@ or stopped with Ctrl-C -- run the console command in subprocesses.
 
 from __future__ import annotations
 
+import functools
 import json
 import os
 import shutil
@@ -49,6 +50,15 @@ SCENARIOS = {
     '<geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01"/></body></worldbody>'
     '<actuator><motor joint="elbow"/></actuator></mujoco>',
 }
+
+FULL_FORM_EDITS = {
+    "full-mass-tiny.toml": ("mass_kg = 0.3", "mass_kg = 1e-300"),
+    "full-gravity-huge.toml": ("gravity_m_per_s2 = [0.0, -0.0]", "gravity_m_per_s2 = [0.0, -1e300]"),
+    "full-point-huge.toml": ("pin = [0.05, 0.0]", "pin = [1e300, 0.0]"),
+    "full-modulus-huge.toml": ("youngs_modulus_pa = 207000000000.0", "youngs_modulus_pa = 1e300"),
+    "full-speed-huge.toml": ("speed_rad_per_s = 523.5987755982989", "speed_rad_per_s = 1e300"),
+}
+"""Whole-mechanism scenario files: the default slider-crank written out, one value changed."""
 
 RPM_CAP = "at most 60,000"
 NO_RING = "the exact contact has no ring"
@@ -125,6 +135,11 @@ BATTERY: list[tuple[str, list[str], list[str]]] = [
         ["mjcf", "--scenario", "{tmp}/ok.toml", "--clearance-mm", "0.2"],
         ["--clearance-mm", "cannot be given"],
     ),
+    ("full-form-mass-tiny", ["run", "--scenario", "{tmp}/full-mass-tiny.toml"], ["'crank'", "mass_kg", "1e-300 kg"]),
+    ("full-form-gravity-huge", ["run", "--scenario", "{tmp}/full-gravity-huge.toml"], ["gravity_m_per_s2", "at most"]),
+    ("full-form-point-huge", ["run", "--scenario", "{tmp}/full-point-huge.toml"], ["[points_m]", "'pin'", "at most"]),
+    ("full-form-modulus-huge", ["run", "--scenario", "{tmp}/full-modulus-huge.toml"], ["youngs_modulus_pa"]),
+    ("full-form-speed-huge", ["run", "--scenario", "{tmp}/full-speed-huge.toml"], ["speed_rad_per_s", "6283.19"]),
     (
         "mjcf-scenario-missing",
         ["mjcf", "--scenario", "{tmp}/no.toml", "--out", "{tmp}/m.xml"],
@@ -323,6 +338,15 @@ BATTERY: list[tuple[str, list[str], list[str]]] = [
 ]
 
 
+@functools.cache
+def _full_form() -> str:
+    """The default slider-crank as a whole-mechanism scenario file."""
+    from clearance.builders import slider_crank
+    from clearance.builders.scenario import dumps_scenario
+
+    return dumps_scenario(slider_crank())
+
+
 def _unwritable(folder: Path) -> bool:
     """Make ``folder`` unwritable for this user (chmod, or chattr +i as root); whether it worked."""
     if os.geteuid() != 0:
@@ -399,6 +423,10 @@ def test_bad_input_battery(argv, words, tmp_path, monkeypatch, capsys, no_work):
     for name, text in SCENARIOS.items():
         (tmp_path / name).write_text(text)
     (tmp_path / "binary.toml").write_bytes(b"\xff\xfe\x00[mechanism]")
+    full = _full_form()
+    for name, (old, new) in FULL_FORM_EDITS.items():
+        assert old in full, old
+        (tmp_path / name).write_text(full.replace(old, new, 1))
     places = {"{tmp}": str(tmp_path), "{file}": str(tmp_path / "afile"), "{dir}": str(tmp_path / "adir")}
     if any("/sys" in a for a in argv) and not _sys_is_read_only():
         pytest.skip("no read-only /sys on this system")

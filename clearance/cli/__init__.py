@@ -114,8 +114,9 @@ def _dispatch(argv: list[str]) -> int:
     try:
         return command(args)
     except (ValueError, AssemblyError, PluginUnavailableError) as err:
-        print(f"error: {err}", file=sys.stderr)
-        return 2
+        from clearance.cli.messages import error
+
+        return error(err)
 
 
 if __name__ == "__main__":

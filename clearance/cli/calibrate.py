@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import argparse
-import sys
 from collections.abc import Sequence
 
 import numpy as np
 
+from clearance.cli.messages import error
 from clearance.cli.options import (
     add_scenario_args,
     bounded,
@@ -85,8 +85,7 @@ def main_calibrate(argv: Sequence[str] | None = None) -> int:
         with folder_lock(out):
             _calibrate(args, mech, options)
     except (ValueError, CalibrationStabilityError) as exc:
-        print(f"clearance calibrate: error: {exc}", file=sys.stderr)
-        return 2
+        return error(exc, prefix="clearance calibrate: error")
     return 0
 
 

@@ -58,9 +58,10 @@ def catalogue_entry(name: str) -> CatalogueEntry:
 
 
 def usage_error(message: str) -> int:
-    """Print ``error: message`` and return the usage-error exit status 2."""
-    print(f"error: {message}", file=sys.stderr)
-    return 2
+    """Print ``error: message`` on one line and return the usage-error exit status 2."""
+    from clearance.cli.messages import error
+
+    return error(message)
 
 
 def interrupted(out: Path) -> int:
