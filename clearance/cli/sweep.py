@@ -143,8 +143,8 @@ def _sweep(args: argparse.Namespace, out: Path) -> int:
         hi = entry.speed_range[1] if args.stop is None else si(args.stop, "rpm")
         if args.clearance_mm is not None:
             fixed["radial_clearance"] = si(args.clearance_mm, "mm")
-    if args.points > 1 and not lo < hi:
-        unit = "mm" if args.parameter == "clearance" else "rpm"
+    unit = "mm" if args.parameter == "clearance" else "rpm"
+    if args.points > 1 and not lo < hi:  # a default start or stop against one given
         raise UsageError(
             f"--start must be below --stop: the {args.parameter} sweep would run from {lo / si(1, unit):g} to "
             f"{hi / si(1, unit):g} {unit} (give both, or swap them)"
@@ -152,8 +152,8 @@ def _sweep(args: argparse.Namespace, out: Path) -> int:
     values = (np.geomspace if args.log else np.linspace)(lo, hi, args.points)
     make = KeywordFactory(entry.builder, fixed=fixed)
     options = sweep_options(args)
-    unit = "mm" if args.parameter == "clearance" else "rpm"
-    probed, _ = (  # the ends of the range: the bounds of `clearance.cli.limits` are monotonic in both
+    # the two ends of the range: each bound of `clearance.cli.limits` is met first at one of them
+    probed, _ = (
         probe(
             make,
             {key: float(v)},
