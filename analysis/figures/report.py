@@ -133,21 +133,27 @@ def lag_lines(lag: OutputLag) -> list[str]:
     ]
 
 
-def reactions_section(result: SimulationResult, window: Window) -> list[str]:
-    """The report's "Joint reactions" section (the bearing load at every joint).
+def reactions_section(result: SimulationResult, ideal: SimulationResult, window: Window, out: Path) -> list[str]:
+    """The report's "Joint reactions" section (the bearing load at every joint) and its figure.
 
-    `write_report` calls it only for a result that carries joint reaction series
-    (``SimulationResult.joint_reactions``), after the contact section; the section's tables
-    and figures belong to the joint-reaction analysis and are not drawn here.
+    Draws ``joint_reactions.png`` (`plot_reactions`) and returns the section of
+    `reaction_section`, both with the report's start-up window.
 
     Args:
-        result: a run with joint reaction series.
+        result: a run with joint reaction series (``SimulationResult.joint_reactions``).
+        ideal: its ideal twin's run.
         window: its start-up window.
+        out: the report's folder.
 
     Returns:
-        The section's Markdown lines (none drawn here).
+        The section's Markdown lines.
     """
-    return []
+    from clearance.analysis.figures.reaction_figures import plot_reactions, reaction_section
+    from clearance.analysis.metrics.reactions import summarise_reactions
+
+    rows = summarise_reactions(result, ideal, startup=window.startup)
+    plot_reactions(result, ideal, startup=window.startup, path=out / "joint_reactions.png")
+    return reaction_section(result, ideal, startup=window.startup, figure="joint_reactions.png", rows=rows)
 
 
 def energy_section(result: SimulationResult) -> list[str]:
@@ -301,7 +307,7 @@ def write_report(
     if result.joints:
         lines += contact_section(result, window, out)
     if getattr(result, "joint_reactions", None):  # the joint reactions' section, where the result has them
-        lines += reactions_section(result, window)
+        lines += reactions_section(result, ideal, window, out)
     lines += energy_section(result)
     lines += poincare_section(result, output, window, period, out)
 

@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import argparse
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from clearance.model import Mechanism, OutputKind
 from clearance.results import SimulationResult
+
+if TYPE_CHECKING:
+    from clearance.analysis.metrics.reactions import ReactionSummary
 
 __all__ = ["write_outputs", "duration_from_args", "duration_source", "check_output_paths"]
 
@@ -28,7 +32,7 @@ def check_output_paths(args: argparse.Namespace) -> Path:
 def write_outputs(
     args: argparse.Namespace, mech: Mechanism, result: SimulationResult, ideal: SimulationResult, out: Path
 ) -> None:
-    """Write arrays, summary CSV, the Markdown report with its figures (and a rerun recording).
+    """Write arrays, summary and reactions CSVs, the Markdown report with its figures (and a rerun recording).
 
     Args:
         args: the command's options (``rerun``: a recording path or None).
@@ -38,6 +42,7 @@ def write_outputs(
         out: output folder (exists).
     """
     from clearance.analysis.figures.report import write_report
+    from clearance.analysis.metrics.reactions import summarise_reactions, write_reactions_csv
     from clearance.analysis.metrics.summary import summarise, write_summary_csv
 
     result.save(out / "result")
@@ -56,6 +61,8 @@ def write_outputs(
         print(f"  rerun recording written to {rrd} (open it with: rerun {rrd})")
     rows = summarise(result, ideal, startup=period or 0.0)
     write_summary_csv(rows, out / "summary.csv")
+    reactions = summarise_reactions(result, ideal, startup=skip)
+    write_reactions_csv(reactions, out / "reactions.csv")
     write_report(out, result, ideal, skip=skip)
     output = mech.outputs[0].name
     angular = mech.outputs[0].kind is OutputKind.ANGLE
@@ -80,9 +87,18 @@ def write_outputs(
             )
         elif r.startup_window > 0:
             print(f"  {r.joint}: no steady state: the run is no longer than its start-up window ({window})")
+    joints = [r for r in reactions if r.kind == "joint"]
+    if joints:
+        loads = ", ".join(f"{r.name} {_peak(r) / 1e3:.3g} kN" for r in joints)
+        print(f"  joint reactions, {'steady-state' if joints[0].has_steady_state else 'whole-run'} peaks: {loads}")
     if rows:
         unit, scale = ("rad", 1.0) if angular else ("mm", 1e3)
         print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * scale:.4g} {unit}")
+
+
+def _peak(r: ReactionSummary) -> float:
+    """A reaction's steady-state peak where the run has a steady state, else its whole-run peak."""
+    return r.steady_peak if r.has_steady_state else r.peak
 
 
 def duration_source(args: argparse.Namespace, default_revolutions: float) -> str:
