@@ -53,6 +53,7 @@ FIXED_OUTPUTS = (
     "ideal.npz",
     "ideal.json",
     "summary.csv",
+    "reactions.csv",
     "report.md",
     "model.xml",
     "ideal_model.xml",
