@@ -11,6 +11,7 @@ from __future__ import annotations
 import textwrap
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from matplotlib import colormaps
@@ -24,9 +25,12 @@ from clearance.analysis.figures.canvas import envelope, new_figure, save_png, th
 from clearance.analysis.figures.plots import MODE_COLOURS, save_figure
 from clearance.analysis.metrics.response import ContactMode, JointContactModes
 from clearance.analysis.metrics.statistics import DeviationStatistics, deviation_series
-from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
-from clearance.analysis.sweeps.criticality import CriticalityRanking
 from clearance.results import SimulationResult
+
+if TYPE_CHECKING:  # the sweeps' modules load only where a diagram or ranking is drawn
+    from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
+    from clearance.analysis.sweeps.criticality import CriticalityRanking
+
 
 __all__ = [
     "quantity_label",

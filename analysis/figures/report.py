@@ -14,18 +14,23 @@ numbers.
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from clearance.analysis.figures import analysis_figures as figures
 from clearance.analysis.figures import plots
+from clearance.analysis.figures.drawing import draw, figures_in_parallel
 from clearance.analysis.figures.report_sections import Window, contact_section, poincare_section, section_points
 from clearance.analysis.metrics.lag import OutputLag, joint_lag
 from clearance.analysis.metrics.response import window_peaks
 from clearance.analysis.metrics.statistics import deviation_statistics, drive_period
-from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
-from clearance.analysis.sweeps.criticality import CriticalityRanking, ranking_markdown
 from clearance.results import ENERGY_TERMS, SimulationResult, atomic_write_text
+
+if TYPE_CHECKING:  # the sweeps' modules load only where a diagram or ranking is drawn
+    from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
+    from clearance.analysis.sweeps.criticality import CriticalityRanking
+
 
 __all__ = ["write_report", "joint_sections", "energy_section", "lag_lines", "reactions_section", "startup_lines"]
 
@@ -152,7 +157,7 @@ def reactions_section(result: SimulationResult, ideal: SimulationResult, window:
     from clearance.analysis.metrics.reactions import summarise_reactions
 
     rows = summarise_reactions(result, ideal, startup=window.startup)
-    plot_reactions(result, ideal, startup=window.startup, path=out / "joint_reactions.png")
+    draw(plot_reactions, result, ideal, startup=window.startup, path=out / "joint_reactions.png")
     return reaction_section(result, ideal, startup=window.startup, figure="joint_reactions.png", rows=rows)
 
 
@@ -204,7 +209,7 @@ def _deviation_lines(
         st = deviation_statistics(result, ideal, output, skip=skip)
     except ValueError as err:  # fewer than 3 samples in the window
         return lines + [f"No deviation statistics: {err}.", ""]
-    figures.plot_deviation(result, ideal, output, st, path=out / "deviation.png")
+    draw(figures.plot_deviation, result, ideal, output, st, path=out / "deviation.png")
     lines += ["| statistic | value |", "|---|---:|"]
     lines += [f"| {k} | {_g(v) if isinstance(v, float) else v} |" for k, v in st.as_dict().items()]
     what = (
@@ -233,6 +238,7 @@ def write_report(
     title: str | None = None,
     bifurcation: BifurcationDiagram | None = None,
     ranking: CriticalityRanking | None = None,
+    processes: int = 1,
 ) -> Path:
     """Analyse a run against its ideal twin and write ``<out_dir>/report.md`` with figures.
 
@@ -247,6 +253,8 @@ def write_report(
         title: report title (default from the mechanism name).
         bifurcation: a diagram to include.
         ranking: a criticality ranking to include.
+        processes: 2 draws the figures in this process and a forked child at once
+            (`clearance.analysis.figures.drawing`); 1 draws them here, one after the other.
 
     Returns:
         Path of ``report.md``.
@@ -262,6 +270,25 @@ def write_report(
         raise KeyError(f"output {output!r} not in the result (have {positions})")
     period = drive_period(result)
     window = Window(float(result.times[0]), period if skip is None else skip, float(result.times[-1]))
+    with figures_in_parallel(processes):
+        lines = _report_lines(out, result, ideal, output, window, period, title, bifurcation, ranking)
+    path = out / "report.md"
+    atomic_write_text(path, "\n".join(lines))
+    return path
+
+
+def _report_lines(
+    out: Path,
+    result: SimulationResult,
+    ideal: SimulationResult,
+    output: str,
+    window: Window,
+    period: float,
+    title: str | None,
+    bifurcation: BifurcationDiagram | None,
+    ranking: CriticalityRanking | None,
+) -> list[str]:
+    """The report's Markdown lines; its figures are handed to `draw`."""
     md = result.metadata
     lines = [f"# {title or md.get('mechanism', 'run')}: response with clearance", ""]
     lines += ["| item | value |", "|---|---|"]
@@ -288,8 +315,14 @@ def write_report(
 
     lines += ["## Response against the ideal mechanism", ""]
     angular = "angle" in output
-    plots.plot_response(
-        result, ideal, output, angular=angular, startup=window.startup, path=out / "response_vs_ideal.png"
+    draw(
+        plots.plot_response,
+        result,
+        ideal,
+        output,
+        angular=angular,
+        startup=window.startup,
+        path=out / "response_vs_ideal.png",
     )
     lines += ["![response](response_vs_ideal.png)", ""]
     keys = [k for k in (output, f"{output}_vel", f"{output}_acc") if k in result.outputs]
@@ -312,7 +345,7 @@ def write_report(
     lines += poincare_section(result, output, window, period, out)
 
     if bifurcation is not None:
-        figures.plot_bifurcation(bifurcation, path=out / "bifurcation.png")
+        draw(figures.plot_bifurcation, bifurcation, path=out / "bifurcation.png")
         counts = {r: bifurcation.regimes.count(r) for r in dict.fromkeys(bifurcation.regimes)}
         lines += [
             "## Bifurcation diagram",
@@ -323,8 +356,8 @@ def write_report(
             "",
         ]
     if ranking is not None:
-        figures.plot_criticality(ranking, path=out / "criticality.png")
+        draw(figures.plot_criticality, ranking, path=out / "criticality.png")
+        from clearance.analysis.sweeps.criticality import ranking_markdown
+
         lines += ["## Joint criticality", "", ranking_markdown(ranking), "![criticality](criticality.png)", ""]
-    path = out / "report.md"
-    atomic_write_text(path, "\n".join(lines))
-    return path
+    return lines

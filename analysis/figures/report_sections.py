@@ -22,6 +22,7 @@ from clearance.analysis.chaos.poincare import (
 )
 from clearance.analysis.figures import analysis_figures as figures
 from clearance.analysis.figures import plots
+from clearance.analysis.figures.drawing import draw
 from clearance.analysis.metrics.response import ContactMode, JointContactModes, contact_modes
 from clearance.analysis.metrics.summary import JointSummary, joint_summary
 from clearance.results import SimulationResult
@@ -170,9 +171,10 @@ def contact_section(result: SimulationResult, window: Window, out: Path) -> list
         parts.append((steady, t >= window.split, {"skip": window.startup}))
     else:
         parts = [(f"whole run, {window.ms(window.start, window.end)}", np.ones(len(t), bool), {})]
-    plots.plot_contact_force(result, startup=window.startup, modes=whole, path=out / "contact_force.png")
+    draw(plots.plot_contact_force, result, startup=window.startup, modes=whole, path=out / "contact_force.png")
     by_part = {label: [contact_modes(result, j, **kw) for j in joints] for label, sel, kw in parts if sel.any()}
-    figures.plot_contact_modes(
+    draw(
+        figures.plot_contact_modes,
         by_part,
         title=f"{result.metadata.get('mechanism', '')}: share of time in each contact mode, "
         + ", ".join(label.split(",")[0].split(":")[0] for label in by_part),
@@ -210,7 +212,7 @@ def contact_section(result: SimulationResult, window: Window, out: Path) -> list
         "",
     ]
     for j in joints:
-        plots.plot_orbit(result, j, clearance_of(result, j), startup=window.startup, path=out / f"orbit_{j}.png")
+        draw(plots.plot_orbit, result, j, clearance_of(result, j), startup=window.startup, path=out / f"orbit_{j}.png")
         lines += [f"![orbit {j}](orbit_{j}.png)", ""]
     return lines
 
@@ -260,11 +262,14 @@ def poincare_section(result: SimulationResult, output: str, window: Window, peri
         if warning:
             warnings.append(f"{names[0]} / {names[1]}: {warning}")
         if names[1].endswith("_vel"):
-            figures.plot_phase_portrait(phase_portrait(result, names[0]), section=pts, path=out / f"phase_{k}.png")
+            draw(
+                figures.plot_phase_portrait, phase_portrait(result, names[0]), section=pts, path=out / f"phase_{k}.png"
+            )
             pngs.append((k, f"phase_{k}.png"))
         else:
             joint = names[0].rpartition(".")[0]
-            figures.plot_poincare(
+            draw(
+                figures.plot_poincare,
                 pts,
                 names,
                 cl,

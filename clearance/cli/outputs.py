@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -63,7 +64,8 @@ def write_outputs(
     write_summary_csv(rows, out / "summary.csv")
     reactions = summarise_reactions(result, ideal, startup=skip)
     write_reactions_csv(reactions, out / "reactions.csv")
-    write_report(out, result, ideal, skip=skip)
+    # the figures in two processes where there are two CPUs (each drawn once, the child waited for)
+    write_report(out, result, ideal, skip=skip, processes=2 if (os.cpu_count() or 1) >= 2 else 1)
     output = mech.outputs[0].name
     angular = mech.outputs[0].kind is OutputKind.ANGLE
     for r in rows:
