@@ -430,7 +430,7 @@ def test_cli_refuses_a_missing_or_broken_model_file(tmp_path, capsys):
         with pytest.raises(SystemExit) as stop:
             main(["retrofit", str(broken), "--joint", "a", "--out", str(tmp_path / "o"), *bad])
         assert stop.value.code == 2
-    assert "--friction must be a finite number in [0, inf)" in capsys.readouterr().err
+    assert "--friction must be at least 0 (got -1)" in capsys.readouterr().err
 
 
 def test_cli_retrofits_the_reacher_calibrated(tmp_path, capsys):

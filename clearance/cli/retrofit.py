@@ -13,12 +13,11 @@ from __future__ import annotations
 
 import argparse
 import math
-from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from clearance.cli.limits import check_clearance, check_steps
-from clearance.cli.options import positive, segments_option, si, timestep_option
+from clearance.cli.options import bounded, positive, segments_option, si, timestep_option
 from clearance.cli.paths import check_folder, folder_lock
 from clearance.model import ContactLaw, Material
 from clearance.units import UNITS
@@ -40,25 +39,6 @@ JOINT_KEYS = {
 }
 """Per-joint keys of ``--joint NAME:key=value,...`` -> the option they override ('': none; the
 journal's start in its bearing frame, [mm], defaults to the centre)."""
-
-
-def _in_range(name: str, low: float, high: float, *, low_open: bool, high_open: bool) -> Callable[[str], float]:
-    """An argparse ``type``: a finite float in the interval, the message naming ``name``."""
-    left, right = ("(" if low_open else "["), (")" if high_open else "]")
-
-    def conv(text: str) -> float:
-        try:
-            v = float(text)
-        except ValueError:
-            raise argparse.ArgumentTypeError(f"{name} must be a number (got {text!r})") from None
-        ok = math.isfinite(v) and (v > low if low_open else v >= low) and (v < high if high_open else v <= high)
-        if not ok:
-            raise argparse.ArgumentTypeError(
-                f"{name} must be a finite number in {left}{low:g}, {high:g}{right} (got {text})"
-            )
-        return v
-
-    return conv
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -100,19 +80,19 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     play.add_argument(
         "--poisson-ratio",
-        type=_in_range("--poisson-ratio", 0.0, 0.5, low_open=False, high_open=True),
+        type=bounded(float, "--poisson-ratio", 0.0, 0.5),
         default=0.3,
         help="Poisson's ratio of journal and bearing (default 0.3)",
     )
     play.add_argument(
         "--restitution",
-        type=_in_range("--restitution", 0.0, 1.0, low_open=True, high_open=False),
+        type=bounded(float, "--restitution", hi=1.0),
         default=0.9,
         help="coefficient of restitution (default 0.9)",
     )
     play.add_argument(
         "--friction",
-        type=_in_range("--friction", 0.0, math.inf, low_open=False, high_open=True),
+        type=bounded(float, "--friction", 0.0),
         default=0.0,
         help="Coulomb friction coefficient (default 0)",
     )
@@ -145,7 +125,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     motion = p.add_argument_group("sizing motion (the unmodified model under a sinusoid on every actuator)")
     motion.add_argument(
         "--sine-amplitude",
-        type=_in_range("--sine-amplitude", 0.0, math.inf, low_open=False, high_open=True),
+        type=bounded(float, "--sine-amplitude", 0.0),
         default=0.5,
         help="fraction of each actuator's control half-range (default 0.5)",
     )
