@@ -87,18 +87,9 @@ def check_folder(path: str | os.PathLike[str], option: str = "--out") -> Path:
         if p.exists():
             if not p.is_dir():
                 raise ValueError(f"{option} {p}: is a file, not a folder; give a folder to write the outputs in")
-            try:
-                _probe_folder(p)
-            except OSError as err:
-                raise ValueError(f"{option} {p}: cannot write in this folder ({_why(err)})") from None
+            _check_writable(p, p, option, "this folder")
             return p
-        a = _existing_ancestor(p)
-        if not a.is_dir():
-            raise ValueError(f"{option} {p}: {a} is a file, not a folder, so no folder can be made under it")
-        try:
-            _probe_create(a)
-        except OSError as err:
-            raise ValueError(f"{option} {p}: cannot create a folder in {a} ({_why(err)})") from None
+        _check_creatable(p, p, option)
     except OSError as err:  # a path the system refuses to look at (too long, a loop, no access)
         raise ValueError(f"{option} {p}: {_why(err)}") from None
     return p
@@ -130,21 +121,31 @@ def check_file(path: str | os.PathLike[str], option: str, *, example: str = "out
         if parent.exists():
             if not parent.is_dir():
                 raise ValueError(f"{option} {p}: {parent} is a file, not a folder")
-            try:
-                _probe_folder(parent)
-            except OSError as err:
-                raise ValueError(f"{option} {p}: cannot write in {parent} ({_why(err)})") from None
+            _check_writable(p, parent, option, str(parent))
             return p
-        a = _existing_ancestor(parent)
-        if not a.is_dir():
-            raise ValueError(f"{option} {p}: {a} is a file, not a folder, so no folder can be made under it")
-        try:
-            _probe_create(a)
-        except OSError as err:
-            raise ValueError(f"{option} {p}: cannot create a folder in {a} ({_why(err)})") from None
+        _check_creatable(p, parent, option)
     except OSError as err:
         raise ValueError(f"{option} {p}: {_why(err)}") from None
     return p
+
+
+def _check_writable(p: Path, folder: Path, option: str, where: str) -> None:
+    """Refuse ``p`` when nothing can be written in its existing ``folder``."""
+    try:
+        _probe_folder(folder)
+    except OSError as err:
+        raise ValueError(f"{option} {p}: cannot write in {where} ({_why(err)})") from None
+
+
+def _check_creatable(p: Path, folder: Path, option: str) -> None:
+    """Refuse ``p`` when its missing ``folder`` cannot be created under its nearest existing ancestor."""
+    a = _existing_ancestor(folder)
+    if not a.is_dir():
+        raise ValueError(f"{option} {p}: {a} is a file, not a folder, so no folder can be made under it")
+    try:
+        _probe_create(a)
+    except OSError as err:
+        raise ValueError(f"{option} {p}: cannot create a folder in {a} ({_why(err)})") from None
 
 
 def _holder_text(fd: int) -> str:
