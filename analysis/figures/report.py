@@ -304,7 +304,7 @@ def _report_lines(
         "wall_time_s",
         "mujoco_version",
     ):
-        if key in md:
+        if key in md and md[key] not in (None, "", {}, []):  # e.g. no ring segments in the exact mode
             lines.append(f"| {key} | {md[key]} |")
     lines.append(
         f"| simulated time | {result.times[-1] * 1e3:.4g} ms ({result.times[-1] / period:.3g} drive periods) |"
