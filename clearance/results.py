@@ -238,6 +238,9 @@ class SimulationResult:
         joint_reactions: joint name -> (n, 2) force that the joint's link_a exerts on its link_b,
             world frame [N] (module docstring); every joint of the mechanism, in its order; empty
             in results saved before reactions existed.
+        body_poses: (n, n_bodies, 7) world position (x, y, z) [m] and orientation quaternion
+            (w, x, y, z) of every body of a 3-D model (``metadata['bodies']`` names them, the
+            world body first); empty (0 rows) for planar mechanisms, which use ``link_poses``.
     """
 
     times: np.ndarray
@@ -251,6 +254,7 @@ class SimulationResult:
     metadata: dict[str, Any] = field(default_factory=dict)
     energy: dict[str, np.ndarray] = field(default_factory=dict)
     joint_reactions: dict[str, np.ndarray] = field(default_factory=dict)
+    body_poses: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 7)))
 
     def __len__(self) -> int:
         return len(self.times)
@@ -283,6 +287,7 @@ class SimulationResult:
             metadata=self.metadata,
             energy={k: v[sl] for k, v in self.energy.items()},
             joint_reactions={k: v[sl] for k, v in self.joint_reactions.items()},
+            body_poses=self.body_poses[sl] if len(self.body_poses) else self.body_poses,
         )
 
     def decimated(self, every: int) -> SimulationResult:
@@ -313,6 +318,7 @@ class SimulationResult:
             metadata=first.metadata,
             energy={k: cat([p.energy[k] for p in parts]) for k in first.energy},
             joint_reactions={k: cat([p.joint_reactions[k] for p in parts]) for k in first.joint_reactions},
+            body_poses=cat([p.body_poses for p in parts]) if len(first.body_poses) else first.body_poses,
         )
 
     # -- persistence --------------------------------------------------------------------
@@ -350,6 +356,8 @@ class SimulationResult:
             arrays[f"energy/{k}"] = v
         for k, v in self.joint_reactions.items():
             arrays[f"reaction/{k}"] = v
+        if len(self.body_poses):
+            arrays["body_poses"] = self.body_poses
         buf = io.BytesIO()
         # numpy's stubs type **kwds against the allow_pickle keyword (absent before numpy 2.1) too
         (np.savez_compressed if compress else np.savez)(buf, **arrays)  # type: ignore[arg-type]
@@ -388,6 +396,7 @@ class SimulationResult:
                 metadata=meta,
                 energy={k: z[f"energy/{k}"] for k in energy_names},
                 joint_reactions={k: z[f"reaction/{k}"] for k in reaction_names},
+                body_poses=z["body_poses"] if "body_poses" in z.files else np.zeros((0, 0, 7)),
             )
 
 

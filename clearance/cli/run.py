@@ -15,6 +15,7 @@ from clearance.cli.options import (
 )
 from clearance.cli.outputs import check_output_paths, duration_from_args, duration_source, write_outputs
 from clearance.cli.paths import folder_lock
+from clearance.cli.run_model import add_model_args, model_command, uses_model
 from clearance.model import Mechanism
 from clearance.options import ModelOptions
 
@@ -50,6 +51,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         metavar="PATH",
         help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH",
     )
+    add_model_args(r)
     r.set_defaults(run_command=command)
 
 
@@ -60,6 +62,8 @@ def command(args: argparse.Namespace) -> int:
     the folder is locked (`clearance.cli.paths.folder_lock`) from the preparation of the
     models to the last file written, and a run refused while preparing leaves no folder.
     """
+    if uses_model(args):
+        return model_command(args)
     out = check_output_paths(args)
     mech = mechanism_from_args(args)
     options = options_from_args(args)

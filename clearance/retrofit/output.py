@@ -2,7 +2,8 @@
 
 ``model.xml`` (the retrofitted model, ring mode: stock MuJoCo compiles it), ``original.xml``
 (the unmodified model with the same asset-path fixes, for comparison runs) and
-``retrofit.md`` (every change; `clearance.retrofit.report`). The written model is compiled
+``retrofit.md`` (every change; `clearance.retrofit.report`) and ``retrofit.json`` (what a run
+of the model reads: `clearance.retrofit.manifest`). The written model is compiled
 again from its file before the report is written, so a model that would not load is never
 reported as done.
 """
@@ -16,10 +17,11 @@ import mujoco
 
 from clearance.results import atomic_write_text
 from clearance.retrofit.assets import relocate_assets
+from clearance.retrofit.manifest import MANIFEST_FILE, HingeRecord, RetrofitManifest
 from clearance.retrofit.pipeline import Retrofit
 from clearance.retrofit.report import retrofit_report
 
-__all__ = ["MODEL_FILE", "TWIN_FILE", "REPORT_FILE", "write_retrofit"]
+__all__ = ["MODEL_FILE", "TWIN_FILE", "REPORT_FILE", "manifest_of", "write_retrofit"]
 
 MODEL_FILE = "model.xml"
 TWIN_FILE = "original.xml"
@@ -34,7 +36,7 @@ def write_retrofit(
     source: str = "",
     command: str = "",
 ) -> dict[str, Path]:
-    """Write ``model.xml``, ``original.xml`` and ``retrofit.md`` into ``out_dir``.
+    """Write ``model.xml``, ``original.xml``, ``retrofit.md`` and ``retrofit.json`` into ``out_dir``.
 
     Args:
         result: the retrofit.
@@ -45,7 +47,7 @@ def write_retrofit(
         command: the command line, for the report.
 
     Returns:
-        File role ('model', 'original', 'report') -> path.
+        File role ('model', 'original', 'report', 'manifest') -> path.
 
     Raises:
         RuntimeError: the written model does not compile from its file.
@@ -53,7 +55,12 @@ def write_retrofit(
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
     src = Path(source_dir if source_dir is not None else (result.twin_spec.modelfiledir or "."))
-    paths = {"model": out / MODEL_FILE, "original": out / TWIN_FILE, "report": out / REPORT_FILE}
+    paths = {
+        "model": out / MODEL_FILE,
+        "original": out / TWIN_FILE,
+        "report": out / REPORT_FILE,
+        "manifest": out / MANIFEST_FILE,
+    }
     changes: list[str] = []
     for role, spec in (("model", result.spec), ("original", result.twin_spec)):
         copy = spec.copy()
@@ -65,5 +72,37 @@ def write_retrofit(
         mujoco.MjModel.from_xml_path(str(paths["model"]))
     except ValueError as err:
         raise RuntimeError(f"the written model {paths['model']} does not compile: {err}") from None
+    atomic_write_text(paths["manifest"], manifest_of(result).to_json())
     atomic_write_text(paths["report"], retrofit_report(result, source=source, command=command, asset_changes=changes))
     return paths
+
+
+def manifest_of(result: Retrofit) -> RetrofitManifest:
+    """The machine-readable record of ``result`` (`clearance.retrofit.manifest`)."""
+    hinges = tuple(
+        HingeRecord(
+            name=h.name,
+            slides=h.elements.slides,
+            journal_site=h.elements.journal_site,
+            bearing_site=h.elements.bearing_site,
+            journal_body=h.elements.journal_body,
+            bearing_body=h.elements.bearing_body,
+            eccentricity_sensor=h.elements.sensors[0],
+            force_sensor=h.elements.sensors[1],
+            radial_clearance=h.play.clearance.radial_clearance,
+            bearing_radius=h.play.clearance.bearing_radius,
+            penetration_limit=h.sizing.penetration_limit,
+            segments=h.sizing.segments,
+        )
+        for h in result.hinges.values()
+    )
+    return RetrofitManifest(
+        model=MODEL_FILE,
+        original=TWIN_FILE,
+        timestep=result.timestep,
+        original_timestep=float(result.twin.opt.timestep),
+        contact_mode=result.options.contact_mode.value,
+        hinges=hinges,
+        qpos_map=tuple(int(i) for i in result.cmap.qpos),
+        qvel_map=tuple(int(i) for i in result.cmap.qvel),
+    )

@@ -23,7 +23,7 @@ from clearance.run.preparation import PreparedModel, prepare
 from clearance.run.readout import read_sensors
 from clearance.version import __version__
 
-__all__ = ["SimulationError", "simulate", "simulate_prepared", "default_duration"]
+__all__ = ["SimulationError", "StepFailure", "simulate", "simulate_prepared", "default_duration", "model_stepper"]
 
 _Stepper = Callable[[np.ndarray, int], tuple[np.ndarray, np.ndarray, mujoco.MjData]]
 """(controls (1 or n, nu), n) -> (states (n, nstate), sensors (n, nsensordata), data) of n steps."""
@@ -251,8 +251,16 @@ def _start(model: mujoco.MjModel, qpos0: np.ndarray | None) -> mujoco.MjData:
 
 def _rollout_stepper(prepared: PreparedModel, qpos0: np.ndarray | None = None) -> _Stepper:
     """Chunks with `mujoco.rollout` (no Python per step)."""
-    model = prepared.model
-    data = _start(model, qpos0)
+    return model_stepper(prepared.model, _start(prepared.model, qpos0))
+
+
+StepFailure = _StepFailure
+"""Raised by a `model_stepper` at its first bad step (attributes states, sens, data, reason)."""
+
+
+def model_stepper(model: mujoco.MjModel, data: mujoco.MjData) -> _Stepper:
+    """Chunks of any model from ``data``'s state with `mujoco.rollout`; a chunk that raises a
+    MuJoCo warning stops at its first warning step with `StepFailure` (the rows before it)."""
     kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.empty(mujoco.mj_stateSize(model, kind))
     mujoco.mj_getState(model, data, state, kind)

@@ -1,0 +1,174 @@
+"""``clearance run --model DIR``: run what ``clearance retrofit`` wrote, and its unmodified twin.
+
+    clearance run --model DIR [--control CTRL.csv | --sine-amplitude A --sine-frequency-hz F]
+                  [--duration-ms T] [--site NAME] [--out OUT]
+
+Both models run at the retrofit's time step (``DIR/retrofit.json``) from their first
+keyframe under the same controls: a control file (a header ``time_s,<actuator>,...`` naming
+every actuator once, ``#k`` for an unnamed one; linear interpolation, held beyond its rows)
+or the sinusoid the retrofit was sized from (default). The run's arrays go to
+``result.npz/json``, the twin's to ``ideal.npz/json``, with ``summary.csv``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from clearance.cli.limits import check_steps
+from clearance.cli.options import bounded, positive, si
+
+if TYPE_CHECKING:
+    from clearance.retrofit.drive import Drive
+    from clearance.run.retrofitted import Retrofitted
+
+__all__ = ["add_model_args", "uses_model", "model_command", "SCENARIO_DESTS"]
+
+SCENARIO_DESTS = {
+    "mechanism": "--mechanism",
+    "scenario": "--scenario",
+    "clearance_at": "--clearance-at",
+    "rpm": "--rpm",
+    "timestep_us": "--timestep-us",
+    "segments": "--segments",
+    "journal_geom": "--journal-geom",
+    "segment_geom": "--segment-geom",
+    "contact_mode": "--contact-mode",
+    "revolutions": "--revolutions",
+    "rerun": "--rerun",
+}
+"""Options of a mechanism's run that a retrofitted model's run does not take (dest -> flag)."""
+
+_MODEL_ONLY = {"control": "--control", "sine_amplitude": "--sine-amplitude", "sine_frequency_hz": "--sine-frequency-hz"}
+_MODEL_ONLY["site"] = "--site"
+
+DEFAULT_DURATION_MS = 1000.0
+
+
+def add_model_args(r: argparse.ArgumentParser) -> None:
+    """Add the options of a retrofitted model's run to ``clearance run``."""
+    g = r.add_argument_group(
+        "a retrofitted model (what clearance retrofit wrote) in place of a catalogue scenario",
+    )
+    g.add_argument(
+        "--model",
+        default=None,
+        metavar="DIR",
+        help="a folder written by clearance retrofit (or its model.xml): run it and its unmodified twin at the "
+        f"retrofit's time step (default duration {DEFAULT_DURATION_MS:g} ms)",
+    )
+    g.add_argument(
+        "--control",
+        default=None,
+        metavar="CTRL.csv",
+        help="controls over time: header time_s and one column per actuator (its name, or #k), linear "
+        "interpolation (default: the sinusoid below)",
+    )
+    g.add_argument(
+        "--sine-amplitude",
+        type=bounded(float, "--sine-amplitude", 0.0),
+        default=None,
+        help="sinusoid on every actuator: fraction of its control half-range (default 0.5)",
+    )
+    g.add_argument(
+        "--sine-frequency-hz",
+        type=positive(float, "--sine-frequency-hz"),
+        default=None,
+        help="frequency of that sinusoid [Hz] (default 1)",
+    )
+    g.add_argument(
+        "--site",
+        default=None,
+        metavar="NAME",
+        help="a site (or body) whose deviation from the twin's is reported (an end effector)",
+    )
+
+
+def uses_model(args: argparse.Namespace) -> bool:
+    """True when the options ask for a retrofitted model's run; refuses a mix with the other kind.
+
+    Raises:
+        ValueError: scenario options with ``--model``, or model options without it.
+    """
+    if args.model is None:
+        for dest, flag in _MODEL_ONLY.items():
+            if getattr(args, dest, None) is not None:
+                raise ValueError(f"{flag} is for a retrofitted model's run: give --model DIR too")
+        return False
+    for dest, flag in SCENARIO_DESTS.items():
+        if getattr(args, dest, None) is not None:
+            raise ValueError(f"{flag} sets a catalogue scenario; with --model the retrofit's model and time step run")
+    if getattr(args, "gravity", False):
+        raise ValueError("--gravity sets a catalogue scenario; with --model the model's own gravity applies")
+    if args.control is not None and (args.sine_amplitude is not None or args.sine_frequency_hz is not None):
+        raise ValueError("--control and --sine-amplitude/--sine-frequency-hz: give one drive, not both")
+    return True
+
+
+def model_command(args: argparse.Namespace) -> int:
+    """Run ``clearance run --model DIR``; returns the exit status (2: refused or stopped by an error)."""
+    from clearance.cli.outputs import check_output_paths
+    from clearance.cli.paths import folder_lock
+    from clearance.retrofit import SineControl
+    from clearance.retrofit.drive import actuator_labels, read_control_file
+    from clearance.run.retrofitted import load_retrofitted
+
+    out = check_output_paths(args)
+    loaded = load_retrofitted(args.model)
+    drive: Drive
+    if args.control is not None:
+        drive = read_control_file(args.control, actuator_labels(loaded.model))
+    else:
+        amplitude = 0.5 if args.sine_amplitude is None else args.sine_amplitude
+        drive = SineControl(amplitude, 1.0 if args.sine_frequency_hz is None else args.sine_frequency_hz)
+    sites = [args.site] if args.site else []
+    loaded.check_sites(sites)
+    duration = si(args.duration_ms if args.duration_ms else DEFAULT_DURATION_MS, "ms")
+    source = f"--duration-ms {args.duration_ms:g}" if args.duration_ms else f"the default {DEFAULT_DURATION_MS:g} ms"
+    check_steps(duration, loaded.manifest.timestep, source)
+    with folder_lock(out):
+        return _run(args, loaded, drive, sites, duration, out)
+
+
+def _run(
+    args: argparse.Namespace, loaded: Retrofitted, drive: Drive, sites: list[str], duration: float, out: Path
+) -> int:
+    from clearance.analysis.metrics.summary import summarise, write_summary_csv
+    from clearance.run.retrofitted import simulate_retrofitted
+    from clearance.run.simulation import SimulationError
+
+    m = loaded.manifest
+    print(
+        f"{loaded.folder}: radial play at {[h.name for h in m.hinges]}, {duration * 1e3:.4g} ms at "
+        f"h = {m.timestep:g} s (the model's own {m.original_timestep:g} s), {m.contact_mode} ring"
+    )
+    failed = None
+    try:
+        result = simulate_retrofitted(loaded, drive, duration, sites=sites)
+    except SimulationError as err:
+        failed, partial = err, err.partial
+        if partial is None:
+            print(f"error: {failed}", file=sys.stderr)
+            return 2
+        result = partial
+    try:
+        twin = simulate_retrofitted(loaded, drive, duration, twin=True, sites=sites)
+    except SimulationError as err:
+        print(f"error: the unmodified twin, needed for the deviations: {err}", file=sys.stderr)
+        return 2
+    result.save(out / "result")
+    twin.save(out / "ideal")
+    rows = summarise(result, None)
+    write_summary_csv(rows, out / "summary.csv")
+    for r in rows:
+        print(
+            f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, p95 "
+            f"{r.p95_force:.4g} N, {r.impacts} impacts, max penetration {r.max_penetration * 1e6:.3g} µm"
+        )
+    print(f"  {result.metadata['steps_per_second']:.3g} steps/s; wrote {out}/")
+    if failed is not None:
+        print(f"error: {failed}", file=sys.stderr)
+        return 2
+    return 0

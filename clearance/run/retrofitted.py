@@ -1,0 +1,339 @@
+"""Running what `clearance retrofit` wrote: the retrofitted model and its unmodified twin.
+
+`load_retrofitted` reads a folder (``model.xml``, ``original.xml``, ``retrofit.json``);
+`simulate_retrofitted` runs one of its two models under a `Drive` (a control file or the
+sinusoid) at the retrofit's time step, both models at the same step and controls, with
+`mujoco.rollout` in chunks (`clearance.run.simulation.model_stepper`). A run that raises a
+MuJoCo warning, goes non-finite or drives a journal beyond its divergence bound stops with
+`SimulationError` naming the time, the hinge (when one is to blame) and a remedy, carrying
+the rows before the first bad one.
+
+Rows are the sensor rows of `mujoco.rollout` (row i at t = i h, before step i). Each row
+carries every body's world pose (``body_poses``) and, per retrofitted hinge, the journal
+centre in its bearing frame (the eccentricity sensor; its rate is the slides' velocities,
+whose axes are the bearing frame's), the penetration |e| - c and the net contact force on
+the journal rotated into the bearing frame. The world positions of the sites asked for (a
+site, or a body's origin where no site has the name: gymnasium's reacher names its tip a
+body) are ``outputs`` ``site/<name>/x``, ``/y`` and ``/z``.
+"""
+
+from __future__ import annotations
+
+import os
+import time as _time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from clearance.results import JointResult, SimulationResult
+from clearance.retrofit.drive import Drive, drive_controls
+from clearance.retrofit.manifest import HingeRecord, RetrofitManifest, read_manifest
+from clearance.retrofit.motion import initial_data
+from clearance.retrofit.play import RetrofitError
+from clearance.run.simulation import SimulationError, StepFailure, model_stepper
+from clearance.version import __version__
+
+__all__ = ["Retrofitted", "load_retrofitted", "point_of", "simulate_retrofitted", "site_output_names"]
+
+
+@dataclass
+class Retrofitted:
+    """A written retrofit, loaded.
+
+    Attributes:
+        folder: where it was read from.
+        manifest: its ``retrofit.json``.
+        model: the retrofitted model (at the retrofit's time step).
+        twin: the unmodified model, set to the retrofit's time step (its own is the
+            manifest's ``original_timestep``).
+    """
+
+    folder: Path
+    manifest: RetrofitManifest
+    model: mujoco.MjModel
+    twin: mujoco.MjModel
+
+    def check_sites(self, sites: Sequence[str]) -> None:
+        """`RetrofitError` naming a site (or body) that is not in both models."""
+        for name in sites:
+            for label, m in (("model.xml", self.model), ("original.xml", self.twin)):
+                try:
+                    point_of(m, name)
+                except KeyError:
+                    have = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_SITE, i) for i in range(m.nsite)]
+                    have = [h for h in have if h and not h.startswith("clr_")]
+                    raise RetrofitError(
+                        f"site {name!r} does not exist in {self.folder / label}: name a site "
+                        f"({', '.join(have) or 'it has none'}) or a body"
+                    ) from None
+
+
+def point_of(model: mujoco.MjModel, name: str) -> tuple[str, int]:
+    """('site', id) of the site ``name``, else ('body', id) of the body (its origin); KeyError if neither."""
+    sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, name)
+    if sid >= 0:
+        return "site", int(sid)
+    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
+    if bid >= 0:
+        return "body", int(bid)
+    raise KeyError(name)
+
+
+def load_retrofitted(path: str | os.PathLike[str]) -> Retrofitted:
+    """Load the retrofit in folder ``path`` (or the folder of ``path``, a ``model.xml`` in it).
+
+    Raises:
+        RetrofitError: no such folder, no ``retrofit.json``, a model that does not compile,
+            or models that do not match the record (naming the file).
+    """
+    p = Path(path)
+    folder = p.parent if p.is_file() else p
+    if not folder.is_dir():
+        raise RetrofitError(f"{p} does not exist (expected a folder written by clearance retrofit)")
+    manifest = read_manifest(folder)
+    models = []
+    for name in (manifest.model, manifest.original):
+        file = folder / name
+        try:
+            models.append(mujoco.MjModel.from_xml_path(str(file)))
+        except ValueError as err:
+            raise RetrofitError(f"{file} does not compile: {err}") from None
+    model, twin = models
+    if (model.nq, model.nv) != (twin.nq + 2 * len(manifest.hinges), twin.nv + 2 * len(manifest.hinges)):
+        raise RetrofitError(f"{folder}: model.xml and original.xml do not match {folder / 'retrofit.json'}")
+    model.opt.timestep = manifest.timestep
+    twin.opt.timestep = manifest.timestep
+    return Retrofitted(folder, manifest, model, twin)
+
+
+def site_output_names(site: str) -> list[str]:
+    """Output names of a site's world position: ``site/<name>/x``, ``/y``, ``/z``."""
+    return [f"site/{site}/{a}" for a in "xyz"]
+
+
+def simulate_retrofitted(
+    loaded: Retrofitted,
+    drive: Drive,
+    duration: float,
+    *,
+    twin: bool = False,
+    sites: Sequence[str] = (),
+    output_interval: float | None = None,
+    progress: Callable[[float], None] | None = None,
+    chunk_steps: int = 50_000,
+) -> SimulationResult:
+    """Run the retrofitted model (or, with ``twin``, the unmodified one) from its first keyframe.
+
+    Args:
+        loaded: the retrofit.
+        drive: the controls (both models get the same).
+        duration: simulated time [s].
+        twin: run the unmodified model instead.
+        sites: sites whose world positions become outputs (`site_output_names`).
+        output_interval: interval of stored rows [s]; default every step.
+        progress: called with the fraction done after each chunk.
+        chunk_steps: steps per `mujoco.rollout` call.
+
+    Raises:
+        ValueError: a bad duration or interval; `RetrofitError` an unknown site (before any work).
+        SimulationError: the run diverged or raised a MuJoCo warning (partial result attached).
+    """
+    if not (isinstance(duration, (int, float)) and np.isfinite(duration) and duration > 0):
+        raise ValueError(f"duration must be a positive number of seconds (got {duration!r})")
+    if output_interval is not None and not (np.isfinite(output_interval) and output_interval > 0):
+        raise ValueError(f"output_interval must be > 0 s (got {output_interval!r})")
+    loaded.check_sites(sites)
+    model = loaded.twin if twin else loaded.model
+    hinges = () if twin else loaded.manifest.hinges
+    h = float(model.opt.timestep)
+    nstep = max(1, int(round(duration / h)))
+    every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
+    data = initial_data(model)
+    reader = _Reader(model, hinges, sites)
+    step = model_stepper(model, data)
+    parts: list[SimulationResult] = []
+    qpos_before = data.qpos.copy()
+    qvel_before = data.qvel.copy()
+    t0 = _time.perf_counter()
+    done = 0
+    while done < nstep:
+        n = min(chunk_steps, nstep - done)
+        times = (done + np.arange(n)) * h
+        ctrl = drive_controls(model, drive, times)
+        failure = None
+        try:
+            states, sens, _ = step(ctrl, n)
+        except StepFailure as fail:
+            states, sens, failure = fail.states, fail.sens, fail.reason
+        k = len(sens)
+        q = np.vstack([qpos_before[None], states[: max(k - 1, 0), 1 : 1 + model.nq]])[:k]
+        v = np.vstack([qvel_before[None], states[: max(k - 1, 0), 1 + model.nq : 1 + model.nq + model.nv]])[:k]
+        part = reader.read(times[:k], sens[:k], q, v)
+        bad = _first_bad(part, hinges, sens[:k], q)
+        if bad is None and failure is not None:
+            bad = (k, None, failure)
+        if bad is not None:
+            idx, joint, why = bad
+            parts.append(part.sliced(slice((-done) % every, idx, every)))
+            result = _finish(parts, loaded, twin, drive, t0, done + idx, every, sites)
+            tb = float(done + idx) * h
+            where = f" at hinge {joint!r}" if joint else ""
+            raise SimulationError(
+                f"{'the unmodified model' if twin else 'the retrofitted model'} diverged at t = {tb:.6g} s{where}: "
+                f"{why}. Remedy: {_remedy(loaded, twin)}. The result up to t = {tb:.6g} s is attached as .partial.",
+                result,
+                time=tb,
+                joint=joint,
+            )
+        parts.append(part.sliced(slice((-done) % every, None, every)))
+        qpos_before = states[-1, 1 : 1 + model.nq].copy()
+        qvel_before = states[-1, 1 + model.nq : 1 + model.nq + model.nv].copy()
+        done += n
+        if progress is not None:
+            progress(done / nstep)
+    return _finish(parts, loaded, twin, drive, t0, nstep, every, sites)
+
+
+def _remedy(loaded: Retrofitted, twin: bool) -> str:
+    h = loaded.manifest.timestep
+    if twin:
+        return f"the unmodified model does not run at the retrofit's step {h:g} s under these controls; check them"
+    return (
+        f"retrofit again with a smaller time step (--timestep-us {h * 1e6 / 2:g}; now {h * 1e6:g}) or more ring "
+        "segments (--segments), or drive the model more gently"
+    )
+
+
+def _first_bad(
+    part: SimulationResult, hinges: Sequence[HingeRecord], sens: np.ndarray, q: np.ndarray
+) -> tuple[int, str | None, str] | None:
+    """(row, hinge or None, reason) of a chunk's first row beyond a bound or non-finite, or None."""
+    n = len(part.times)
+    finite = np.isfinite(sens).all(axis=1) & np.isfinite(q).all(axis=1)
+    first_nan = int(np.argmin(finite)) if not finite.all() else n
+    worst: tuple[int, str, float, float] | None = None
+    for hr in hinges:
+        pen = part.joints[hr.name].penetration
+        over = np.nonzero(pen > hr.penetration_limit)[0]
+        if len(over) and (worst is None or over[0] < worst[0]):
+            worst = (int(over[0]), hr.name, float(pen[over[0]]), hr.penetration_limit)
+    if worst is not None and worst[0] <= first_nan:
+        return (
+            worst[0],
+            worst[1],
+            f"the journal penetrated {worst[2] * 1e6:.3g} um into its bearing, beyond the bound {worst[3] * 1e6:.3g} "
+            "um (4 x the Hertz penetration of the sized impact)",
+        )
+    if first_nan < n:
+        return first_nan, None, "the state became non-finite (NaN or Inf)"
+    return None
+
+
+class _Reader:
+    """Sensor and position rows -> a `SimulationResult` chunk."""
+
+    def __init__(self, model: mujoco.MjModel, hinges: Sequence[HingeRecord], sites: Sequence[str]) -> None:
+        self.model, self.hinges, self.sites = model, hinges, list(sites)
+        self.data = mujoco.MjData(model)
+
+        def sensor(name: str) -> slice:
+            s = model.sensor(name)
+            return slice(int(s.adr[0]), int(s.adr[0] + s.dim[0]))
+
+        def jid(kind: mujoco.mjtObj, name: str) -> int:
+            return int(mujoco.mj_name2id(model, kind, name))
+
+        self.ecc = {hr.name: sensor(hr.eccentricity_sensor) for hr in hinges}
+        self.force = {hr.name: sensor(hr.force_sensor) for hr in hinges}
+        self.bearing_site = {hr.name: jid(mujoco.mjtObj.mjOBJ_SITE, hr.bearing_site) for hr in hinges}
+        self.slide_dof = {
+            hr.name: [int(model.jnt_dofadr[jid(mujoco.mjtObj.mjOBJ_JOINT, s)]) for s in hr.slides] for hr in hinges
+        }
+        self.points = [point_of(model, s) for s in self.sites]
+
+    def read(self, times: np.ndarray, sens: np.ndarray, q: np.ndarray, v: np.ndarray) -> SimulationResult:
+        model, data = self.model, self.data
+        n = len(times)
+        poses = np.zeros((n, model.nbody, 7))
+        site_pos = np.zeros((n, len(self.points), 3))
+        bearing_rot = {name: np.zeros((n, 3, 3)) for name in self.bearing_site}
+        for i in range(n):
+            data.qpos[:] = q[i]
+            if not np.isfinite(q[i]).all():
+                poses[i:] = np.nan
+                site_pos[i:] = np.nan
+                break
+            mujoco.mj_kinematics(model, data)
+            poses[i, :, :3] = data.xpos
+            poses[i, :, 3:] = data.xquat
+            for k, (kind, pid) in enumerate(self.points):
+                site_pos[i, k] = data.site_xpos[pid] if kind == "site" else data.xpos[pid]
+            for name, sid in self.bearing_site.items():
+                bearing_rot[name][i] = data.site_xmat[sid].reshape(3, 3)
+        joints = {}
+        for hr in self.hinges:
+            e = sens[:, self.ecc[hr.name]][:, :2].copy()
+            rate = v[:, self.slide_dof[hr.name]]
+            pen = np.hypot(e[:, 0], e[:, 1]) - hr.radial_clearance
+            # the sensor names only the journal geom, so it reads the force the journal exerts on
+            # the ring: the force on the journal is its opposite
+            f_world = -sens[:, self.force[hr.name]]
+            f = np.einsum("nji,nj->ni", bearing_rot[hr.name], f_world)[:, :2]
+            joints[hr.name] = JointResult(e, rate, pen, f)
+        outputs = {}
+        for k, s in enumerate(self.sites):
+            for a, name in enumerate(site_output_names(s)):
+                outputs[name] = site_pos[:, k, a].copy()
+        return SimulationResult(
+            times=np.asarray(times, dtype=float),
+            outputs=outputs,
+            joints=joints,
+            drive_angle=np.zeros((n, 0)),
+            drive_speed=np.zeros((n, 0)),
+            drive_torque=np.zeros((n, 0)),
+            link_poses=np.zeros((n, 0, 3)),
+            closure_violation=np.zeros(n),
+            body_poses=poses,
+        )
+
+
+def _finish(
+    parts: list[SimulationResult],
+    loaded: Retrofitted,
+    twin: bool,
+    drive: Drive,
+    t0: float,
+    steps: int,
+    every: int,
+    sites: Sequence[str],
+) -> SimulationResult:
+    res = SimulationResult.concatenate(parts)
+    model = loaded.twin if twin else loaded.model
+    wall = _time.perf_counter() - t0
+    m = loaded.manifest
+    res.metadata = {
+        "solver": "mujoco",
+        "mechanism": f"{loaded.folder / (m.original if twin else m.model)}",
+        "retrofit": str(loaded.folder),
+        "model_kind": "unmodified twin" if twin else "retrofitted",
+        "timestep": float(model.opt.timestep),
+        "original_timestep": m.original_timestep,
+        "contact_mode": m.contact_mode,
+        "clearance_joints": [] if twin else [h.name for h in m.hinges],
+        "radial_clearance": {} if twin else {h.name: h.radial_clearance for h in m.hinges},
+        "bodies": [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or f"#{b}" for b in range(model.nbody)],
+        "sites": list(sites),
+        "drive": getattr(drive, "source", "") or repr(drive),
+        "drives": [],
+        "links": [],
+        "steps": steps,
+        "output_every_steps": every,
+        "wall_time_s": wall,
+        "steps_per_second": steps / wall if wall > 0 else None,
+        "mujoco_version": mujoco.__version__,
+        "package_version": __version__,
+    }
+    return res
