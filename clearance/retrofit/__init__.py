@@ -20,6 +20,7 @@ from clearance.retrofit.play import (
     DEFAULT_BEARING_RADIUS,
     DEFAULT_RADIAL_CLEARANCE,
     PREFIX,
+    ControlTable,
     RadialPlay,
     RetrofitError,
     RetrofitOptions,
@@ -31,6 +32,7 @@ if TYPE_CHECKING:
     from clearance.retrofit.pipeline import Retrofit, RetrofittedHinge, retrofit
 
 __all__ = [
+    "ControlTable",
     "DEFAULT_BEARING_RADIUS",
     "DEFAULT_RADIAL_CLEARANCE",
     "PREFIX",

@@ -13,14 +13,13 @@ from __future__ import annotations
 import csv
 import math
 import os
-from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
 from clearance.retrofit.motion import control_signal
-from clearance.retrofit.play import RetrofitError, SineControl
+from clearance.retrofit.play import ControlTable, RetrofitError, SineControl
 
 __all__ = ["TIME_COLUMN", "ControlTable", "Drive", "actuator_labels", "read_control_file", "drive_controls"]
 
@@ -30,21 +29,6 @@ TIME_COLUMN = "time_s"
 def actuator_labels(model: mujoco.MjModel) -> list[str]:
     """Each actuator's name in a control file: its name, or ``#k`` when it has none."""
     return [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_ACTUATOR, k) or f"#{k}" for k in range(model.nu)]
-
-
-@dataclass(frozen=True)
-class ControlTable:
-    """A control sequence: ``values[i, k]`` is actuator k's ctrl at ``times[i]``.
-
-    Attributes:
-        times: (n,) strictly increasing [s].
-        values: (n, nu) controls, columns in the model's actuator order.
-        source: where it was read from (for messages and reports).
-    """
-
-    times: np.ndarray
-    values: np.ndarray
-    source: str = ""
 
 
 Drive = ControlTable | SineControl
@@ -108,12 +92,6 @@ def read_control_file(path: str | os.PathLike[str], labels: list[str]) -> Contro
 
 
 def drive_controls(model: mujoco.MjModel, drive: Drive, times: np.ndarray) -> np.ndarray:
-    """(len(times), nu) controls of ``drive`` at ``times`` [s] for ``model``'s actuators."""
-    t = np.asarray(times, dtype=float)
-    if isinstance(drive, SineControl):
-        return control_signal(model, drive, t)
-    if drive.values.shape[1] != model.nu:
-        raise RetrofitError(f"{drive.source}: {drive.values.shape[1]} actuator columns, the model has {model.nu}")
-    return np.column_stack([np.interp(t, drive.times, drive.values[:, k]) for k in range(model.nu)]).reshape(
-        len(t), model.nu
-    )
+    """(len(times), nu) controls of ``drive`` at ``times`` [s] for ``model``'s actuators
+    (`clearance.retrofit.motion.control_signal`)."""
+    return control_signal(model, drive, times)

@@ -17,16 +17,29 @@ import mujoco
 import numpy as np
 
 from clearance.retrofit.frames import BearingFrame
-from clearance.retrofit.play import SineControl
+from clearance.retrofit.play import ControlTable, RetrofitError, SineControl
 from clearance.retrofit.selection import Hinge
 
 __all__ = ["Motion", "control_signal", "initial_data", "fired_warnings", "twin_motion"]
 
 
-def control_signal(model: mujoco.MjModel, control: SineControl, times: np.ndarray) -> np.ndarray:
-    """(n, nu) controls of `SineControl` at ``times`` [s] for ``model``'s actuators."""
+def control_signal(model: mujoco.MjModel, control: SineControl | ControlTable, times: np.ndarray) -> np.ndarray:
+    """(n, nu) controls of ``control`` at ``times`` [s] for ``model``'s actuators.
+
+    A `ControlTable` is interpolated linearly and held beyond its rows; its column count
+    must be the model's actuator count (`RetrofitError` otherwise).
+    """
     nu = model.nu
-    t = np.asarray(times, dtype=float)[:, None]
+    t = np.asarray(times, dtype=float)
+    if isinstance(control, ControlTable):
+        if control.values.shape[1] != nu:
+            raise RetrofitError(
+                f"control table {control.source}: {control.values.shape[1]} actuator columns, the model has {nu}"
+            )
+        return np.column_stack([np.interp(t, control.times, control.values[:, k]) for k in range(nu)]).reshape(
+            len(t), nu
+        )
+    t = t[:, None]
     k = np.arange(nu)[None, :]
     limited = np.asarray(model.actuator_ctrllimited, dtype=bool)
     lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
@@ -79,7 +92,7 @@ def twin_motion(
     model: mujoco.MjModel,
     hinges: Sequence[Hinge],
     frames: Mapping[str, BearingFrame],
-    control: SineControl,
+    control: SineControl | ControlTable,
     duration: float,
 ) -> Motion:
     """Run the unmodified model for ``duration`` [s] and record the hinges' in-plane loads.

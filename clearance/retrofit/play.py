@@ -12,6 +12,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass, field
 
+import numpy as np
+
 from clearance.checks import finite, positive
 from clearance.model import STEEL, Clearance, ContactLaw, Material
 from clearance.options import ContactMode, GeomType
@@ -25,6 +27,7 @@ __all__ = [
     "RetrofitError",
     "RetrofitOptions",
     "SineControl",
+    "ControlTable",
 ]
 
 PREFIX = "clr_"
@@ -134,6 +137,36 @@ class SineControl:
 
 
 @dataclass(frozen=True)
+class ControlTable:
+    """A control sequence: ``values[i, k]`` is actuator k's ctrl at ``times[i]``; linear in
+    between, held before the first row and after the last (`clearance.retrofit.drive` reads
+    one from a CSV file).
+
+    Attributes:
+        times: (n,) strictly increasing [s].
+        values: (n, nu) controls, columns in the model's actuator order.
+        source: where it came from (for messages and reports).
+    """
+
+    times: np.ndarray
+    values: np.ndarray
+    source: str = ""
+
+    def __post_init__(self) -> None:
+        t = np.asarray(self.times, dtype=float)
+        v = np.asarray(self.values, dtype=float)
+        if t.ndim != 1 or len(t) < 1 or v.ndim != 2 or v.shape[0] != len(t):
+            raise RetrofitError(f"a control table needs (n,) times and (n, nu) values (got {t.shape}, {v.shape})")
+        where = f"control table {self.source}" if self.source else "a control table"
+        if not (np.isfinite(t).all() and np.isfinite(v).all()):
+            raise RetrofitError(f"{where}: times and values must be finite")
+        if len(t) > 1 and not (np.diff(t) > 0).all():
+            raise RetrofitError(f"{where}: times must increase strictly")
+        object.__setattr__(self, "times", t)
+        object.__setattr__(self, "values", v)
+
+
+@dataclass(frozen=True)
 class RetrofitOptions:
     """Numerical choices of a retrofit (not physics).
 
@@ -149,7 +182,8 @@ class RetrofitOptions:
         ripple_limit: largest ring force ripple the segment rule allows [-].
         impedance: constant solimp impedance d of the contact rows [-].
         control: the motion of the unmodified model that loads, masses and impact speeds
-            are sized from, and that the speed cost is measured on.
+            are sized from, and that the speed cost is measured on: a `SineControl` or a
+            `ControlTable` (a servo's set point, a measured sequence).
         sizing_duration: how long that motion is run [s].
         measure_speed: measure steps per second of both models (the speed cost).
         use_cache: read and write stored calibrations.
@@ -162,7 +196,7 @@ class RetrofitOptions:
     timestep: float | None = None
     ripple_limit: float = 0.02
     impedance: float = 1e-3
-    control: SineControl = field(default_factory=SineControl)
+    control: SineControl | ControlTable = field(default_factory=SineControl)
     sizing_duration: float = 1.0
     measure_speed: bool = True
     use_cache: bool = True
@@ -198,6 +232,6 @@ class RetrofitOptions:
             raise RetrofitError(f"ripple_limit must be in (0, 1) (got {self.ripple_limit!r})")
         if not 0 < finite("impedance", self.impedance) < 0.5:
             raise RetrofitError(f"impedance must be in (0, 0.5) (got {self.impedance!r})")
-        if not isinstance(self.control, SineControl):
-            raise RetrofitError(f"control must be a SineControl (got {self.control!r})")
+        if not isinstance(self.control, (SineControl, ControlTable)):
+            raise RetrofitError(f"control must be a SineControl or a ControlTable (got {self.control!r})")
         positive("sizing_duration", self.sizing_duration, "s")

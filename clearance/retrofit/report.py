@@ -6,7 +6,7 @@ import mujoco
 import numpy as np
 
 from clearance.retrofit.pipeline import Retrofit, RetrofittedHinge
-from clearance.retrofit.play import DEFAULT_CLASS
+from clearance.retrofit.play import DEFAULT_CLASS, SineControl
 from clearance.retrofit.sizing import STEP_OMEGA_H
 
 __all__ = ["retrofit_report"]
@@ -18,6 +18,16 @@ def _g(x: float, digits: int = 4) -> str:
 
 def _vec(v: np.ndarray) -> str:
     return "(" + ", ".join(f"{float(x):.4g}" for x in v) + ")"
+
+
+def _control_text(r: Retrofit) -> str:
+    control = r.options.control
+    if isinstance(control, SineControl):
+        return (
+            f"a sinusoid on every actuator (amplitude {_g(control.amplitude)} of each control range's half-width, "
+            f"{_g(control.frequency)} Hz)"
+        )
+    return f"the control table {control.source or ''} ({len(control.times)} rows, linear in between, held beyond)"
 
 
 def _hinge_rows(r: Retrofit) -> list[str]:
@@ -167,8 +177,7 @@ def retrofit_report(r: Retrofit, *, source: str = "", command: str = "", asset_c
         "## Sizing",
         "",
         f"From {len(r.motion.times)} steps ({_g(len(r.motion.times) * h0, 3)} s) of the unmodified model at its own "
-        f"step under a sinusoid on every actuator (amplitude {_g(r.options.control.amplitude)} of each control "
-        f"range's half-width, {_g(r.options.control.frequency)} Hz): the in-plane hinge load (MuJoCo's cfrc_int), "
+        f"step under {_control_text(r)}: the in-plane hinge load (MuJoCo's cfrc_int), "
         "and the effective mass along it in the retrofitted model with its equality constraints held.",
         "",
         *_sizing_rows(r),

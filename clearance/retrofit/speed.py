@@ -1,6 +1,6 @@
 """The speed cost of a retrofit: steps per second of each model at its own time step.
 
-Both models run from their first keyframe under the same `SineControl`, stepped by
+Both models run from their first keyframe under the same control (the sizing motion's), stepped by
 `mujoco.rollout` (no Python per step), for about `MIN_WALL` seconds of wall time each
 after a short warm-up. The cost of simulating one second of the model's motion is the
 ratio of the two models' simulated seconds per wall second: the retrofitted model pays
@@ -17,7 +17,7 @@ import numpy as np
 from mujoco import rollout
 
 from clearance.retrofit.motion import control_signal, fired_warnings, initial_data
-from clearance.retrofit.play import SineControl
+from clearance.retrofit.play import ControlTable, SineControl
 
 __all__ = ["MIN_WALL", "Speed", "SpeedCost", "measure_speed", "run_controlled"]
 
@@ -90,7 +90,9 @@ class ControlledRun:
         return fired_warnings(self.data)
 
 
-def run_controlled(model: mujoco.MjModel, control: SineControl, nstep: int, *, start: float = 0.0) -> ControlledRun:
+def run_controlled(
+    model: mujoco.MjModel, control: SineControl | ControlTable, nstep: int, *, start: float = 0.0
+) -> ControlledRun:
     """Step ``model`` ``nstep`` times from its first keyframe under ``control`` (times from ``start``)."""
     data = initial_data(model)
     kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
@@ -104,7 +106,7 @@ def run_controlled(model: mujoco.MjModel, control: SineControl, nstep: int, *, s
     return ControlledRun(states[0], sens[0], data, wall)
 
 
-def measure_speed(model: mujoco.MjModel, control: SineControl, *, min_wall: float = MIN_WALL) -> Speed:
+def measure_speed(model: mujoco.MjModel, control: SineControl | ControlTable, *, min_wall: float = MIN_WALL) -> Speed:
     """Steps per second of ``model`` at its own step (about ``min_wall`` s of stepping, after a warm-up)."""
     pilot = run_controlled(model, control, 200)
     rate = 200 / max(pilot.wall, 1e-9)
