@@ -13,6 +13,7 @@ import mujoco
 import numpy as np
 import pytest
 
+from clearance.analysis.metrics.site_deviation import site_deviation
 from clearance.cli import main
 from clearance.model import Material
 from clearance.results import SimulationResult
@@ -99,6 +100,31 @@ def test_cli_runs_the_model_and_its_twin_under_the_sinusoid(folder, tmp_path, ca
         assert np.median(np.abs(de - j.eccentricity_rate[:, 0])) < 1e-2 * np.abs(j.eccentricity_rate[:, 0]).max()
     assert twin.joints == {} and "site/fingertip/x" in twin.outputs
     assert (out / "summary.csv").read_text().count("\n") == 3  # header + one row per hinge
+    # the tip is a body of the reacher: its output is that body's pose's position
+    tip = result.metadata["bodies"].index("fingertip")
+    for a, axis in enumerate("xyz"):
+        np.testing.assert_array_equal(result.body_poses[:, tip, a], result.outputs[f"site/fingertip/{axis}"])
+    report = (out / "report.md").read_text()
+    for figure in ("orbit_joint0.png", "orbit_joint1.png", "contact_force.png", "site_deviation_x.png"):
+        assert f"({figure})" in report and (out / figure).stat().st_size > 10_000
+    assert "planar play only" in report and "## Deviation of fingertip from the unmodified twin" in report
+    assert "fingertip: deviation from the twin up to" in stdout
+
+
+def test_site_deviation_statistics_are_those_of_the_two_runs(folder):
+    loaded = load_retrofitted(folder)
+    drive = SineControl(0.5, 2.0)
+    result = simulate_retrofitted(loaded, drive, 0.05, sites=["fingertip"])
+    twin = simulate_retrofitted(loaded, drive, 0.05, twin=True, sites=["fingertip"])
+    dev = site_deviation(result, twin, "fingertip")
+    assert set(dev.axes) == {"site/fingertip/x", "site/fingertip/y"}  # the reacher moves in its plane only
+    for name, stats in dev.axes.items():
+        d = result.outputs[name] - twin.outputs[name]  # the same time grid: no interpolation
+        assert stats.max_deviation == pytest.approx(np.abs(d).max(), rel=1e-12)  # round-off
+        assert stats.rms_deviation == pytest.approx(np.sqrt(np.mean(d**2)), rel=1e-12)
+    assert dev.max_distance > 0  # the play moves the tip: otherwise the statistics say nothing
+    with pytest.raises(KeyError, match="site 'hand'"):
+        site_deviation(result, twin, "hand")
 
 
 def test_control_file_is_interpolated_linearly_and_held_beyond_its_rows(folder, tmp_path):

@@ -7,7 +7,9 @@ Both models run at the retrofit's time step (``DIR/retrofit.json``) from their f
 keyframe under the same controls: a control file (a header ``time_s,<actuator>,...`` naming
 every actuator once, ``#k`` for an unnamed one; linear interpolation, held beyond its rows)
 or the sinusoid the retrofit was sized from (default). The run's arrays go to
-``result.npz/json``, the twin's to ``ideal.npz/json``, with ``summary.csv``.
+``result.npz/json``, the twin's to ``ideal.npz/json``, with ``summary.csv`` (contact
+statistics per hinge), ``site_deviation.csv`` (with ``--site``) and ``report.md`` with its
+figures (`clearance.analysis.figures.model_report`).
 """
 
 from __future__ import annotations
@@ -135,7 +137,10 @@ def model_command(args: argparse.Namespace) -> int:
 def _run(
     args: argparse.Namespace, loaded: Retrofitted, drive: Drive, sites: list[str], duration: float, out: Path
 ) -> int:
+    from clearance.analysis.figures.model_report import write_model_report
+    from clearance.analysis.metrics.site_deviation import site_deviation, write_site_deviation_csv
     from clearance.analysis.metrics.summary import summarise, write_summary_csv
+    from clearance.retrofit import SineControl
     from clearance.run.retrofitted import simulate_retrofitted
     from clearance.run.simulation import SimulationError
 
@@ -162,10 +167,26 @@ def _run(
     twin.save(out / "ideal")
     rows = summarise(result, None)
     write_summary_csv(rows, out / "summary.csv")
+    deviation = None
+    if sites and len(result.times) >= 3:
+        deviation = site_deviation(result, twin, sites[0])
+        write_site_deviation_csv(deviation, out / "site_deviation.csv")
+    # contacts longer than 5 % of the sinusoid's period (of the run, under a control file) are continuous
+    period = 1.0 / drive.frequency if isinstance(drive, SineControl) else duration
+    stopped = None if failed is None else str(failed)
+    write_model_report(out, result, twin, rows, deviation, continuous_after=0.05 * period, stopped=stopped)
     for r in rows:
+        if not r.max_penetration > 0:
+            print(f"  {r.joint}: no contact (the journal stayed {-r.max_penetration * 1e6:.3g} µm from its ring)")
+            continue
         print(
             f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, p95 "
             f"{r.p95_force:.4g} N, {r.impacts} impacts, max penetration {r.max_penetration * 1e6:.3g} µm"
+        )
+    if deviation is not None:
+        axes = ", ".join(f"{k.rsplit('/', 1)[1]} {s.rms_deviation * 1e3:.3g}" for k, s in deviation.axes.items())
+        print(
+            f"  {deviation.site}: deviation from the twin up to {deviation.max_distance * 1e3:.3g} mm; RMS [mm] {axes}"
         )
     print(f"  {result.metadata['steps_per_second']:.3g} steps/s; wrote {out}/")
     if failed is not None:
