@@ -221,3 +221,33 @@ def test_a_run_that_diverges_stops_naming_time_hinge_and_remedy(folder, tmp_path
 def test_an_unknown_site_is_refused_by_the_function_too(folder):
     with pytest.raises(RetrofitError, match="site 'hand' does not exist"):
         simulate_retrofitted(load_retrofitted(folder), SineControl(), 0.01, sites=["hand"])
+
+
+def test_rerun_recording_holds_the_bodies_of_both_models_and_the_orbits(folder, tmp_path, capsys):
+    from tests.test_rerun import F32_RTOL, _read, _view_names
+
+    out = tmp_path / "run"
+    rrd = tmp_path / "run.rrd"
+    argv = ["run", "--model", str(folder), "--duration-ms", "10", "--site", "fingertip", "--out", str(out)]
+    code, stdout, err = _cli([*argv, "--rerun", str(rrd)], capsys)
+    assert code == 0, err
+    assert "rerun recording written to" in stdout
+    result, twin = SimulationResult.load(out / "result"), SimulationResult.load(out / "ideal")
+    store, blueprints = _read(rrd)
+    assert {"model (twin in grey) [m]", "orbit joint0 [µm, bearing frame]", "contact force [N]"} <= _view_names(
+        blueprints
+    )
+    tip = result.metadata["bodies"].index("fingertip")
+    for root, res in (("model", result), ("twin", twin)):
+        logged = store[(f"/{root}/bodies/fingertip", False)]
+        t = logged["sim_time"] * 1e-9
+        rows = np.searchsorted(res.times, t - 1e-12)
+        np.testing.assert_allclose(res.times[rows], t, atol=1e-12)  # display rows are rows of the run
+        pos = logged["Transform3D:translation"][:, 0]
+        # Transform3D stores float32 translations
+        np.testing.assert_allclose(pos, res.body_poses[rows, tip, :3], rtol=2 * F32_RTOL, atol=1e-9)
+        geoms = {k[0].rsplit("/", 1)[1] for k in store if k[0].startswith(f"/{root}/bodies/fingertip/geoms/")}
+        assert geoms == {"fingertip"}  # the reacher's tip geom, named
+    orbit = store[("/joints/joint1/orbit", False)]
+    e = result.joints["joint1"].eccentricity * 1e6
+    np.testing.assert_allclose(orbit["Points2D:positions"].reshape(-1, 2), e, rtol=F32_RTOL, atol=1e-6)

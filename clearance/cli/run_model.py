@@ -1,7 +1,7 @@
 """``clearance run --model DIR``: run what ``clearance retrofit`` wrote, and its unmodified twin.
 
     clearance run --model DIR [--control CTRL.csv | --sine-amplitude A --sine-frequency-hz F]
-                  [--duration-ms T] [--site NAME] [--out OUT]
+                  [--duration-ms T] [--site NAME] [--out OUT] [--rerun RUN.rrd]
 
 Both models run at the retrofit's time step (``DIR/retrofit.json``) from their first
 keyframe under the same controls: a control file (a header ``time_s,<actuator>,...`` naming
@@ -9,7 +9,8 @@ every actuator once, ``#k`` for an unnamed one; linear interpolation, held beyon
 or the sinusoid the retrofit was sized from (default). The run's arrays go to
 ``result.npz/json``, the twin's to ``ideal.npz/json``, with ``summary.csv`` (contact
 statistics per hinge), ``site_deviation.csv`` (with ``--site``) and ``report.md`` with its
-figures (`clearance.analysis.figures.model_report`).
+figures (`clearance.analysis.figures.model_report`); ``--rerun`` also records the bodies of
+both models moving in 3-D with the orbits beside them (`clearance.analysis.recording.model_rerun`).
 """
 
 from __future__ import annotations
@@ -39,7 +40,6 @@ SCENARIO_DESTS = {
     "segment_geom": "--segment-geom",
     "contact_mode": "--contact-mode",
     "revolutions": "--revolutions",
-    "rerun": "--rerun",
 }
 """Options of a mechanism's run that a retrofitted model's run does not take (dest -> flag)."""
 
@@ -175,6 +175,11 @@ def _run(
     period = 1.0 / drive.frequency if isinstance(drive, SineControl) else duration
     stopped = None if failed is None else str(failed)
     write_model_report(out, result, twin, rows, deviation, continuous_after=0.05 * period, stopped=stopped)
+    if args.rerun:
+        from clearance.analysis.recording.model_rerun import record_model_run
+
+        rrd = record_model_run(result, twin, loaded.model, loaded.twin, args.rerun, deviation=deviation).resolve()
+        print(f"  rerun recording written to {rrd} (open it with: rerun {rrd})")
     for r in rows:
         if not r.max_penetration > 0:
             print(f"  {r.joint}: no contact (the journal stayed {-r.max_penetration * 1e6:.3g} µm from its ring)")
