@@ -341,8 +341,8 @@ def test_bad_plays_and_models_are_refused(kit):
         RadialPlay.make(-1e-4)
     with pytest.raises(RetrofitError, match="initial_eccentricity must be smaller than the radial clearance"):
         RadialPlay.make(1e-4, initial_eccentricity=(1e-4, 0.0))
-    with pytest.raises(RetrofitError, match="not available for retrofits yet"):
-        RetrofitOptions(contact_mode="exact")
+    with pytest.raises(RetrofitError, match="contact_mode must be 'calibrated', 'nominal' or 'exact'"):
+        RetrofitOptions(contact_mode="soft")
     spec = mujoco.MjSpec.from_file(str(kit))
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_CONTACT
     with pytest.raises(RetrofitError, match="disables contacts"):
@@ -408,7 +408,6 @@ def _cli(argv: list[str], capsys) -> tuple[int, str, str]:
         (["--joint", "elbow:stiffness=3"], "is not key=value with a key among"),
         (["--joint", "elbow:eccentricity_x_mm=0.1"], "initial eccentricity (0.1, 0) mm must be smaller than"),
         (["--joint", "elbow", "--joint", "elbow"], "hinge 'elbow' is named twice"),
-        (["--joint", "elbow", "--contact-mode", "exact"], "not available for retrofits yet"),
     ],
 )
 def test_cli_refuses_bad_input_before_any_work(kit, tmp_path, capsys, extra, expected):

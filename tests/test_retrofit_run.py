@@ -251,3 +251,35 @@ def test_rerun_recording_holds_the_bodies_of_both_models_and_the_orbits(folder, 
     orbit = store[("/joints/joint1/orbit", False)]
     e = result.joints["joint1"].eccentricity * 1e6
     np.testing.assert_allclose(orbit["Points2D:positions"].reshape(-1, 2), e, rtol=F32_RTOL, atol=1e-6)
+
+
+def test_exact_mode_retrofit_runs_with_the_compiled_contact(tmp_path):
+    """No ring: the compiled plugin between the hinge's two sites, read back through the run."""
+    from clearance.contact_calibration.laws import bearing_stiffness
+    from clearance.contact_plugin import is_available
+
+    if not is_available():
+        pytest.skip("the compiled contact plugin is not built")
+    path = _gym_model("reacher")
+    play = RadialPlay.make(2e-4, 0.01, bearing_material=POLYMER, journal_material=POLYMER)
+    r = retrofit(
+        mujoco.MjSpec.from_file(str(path)),
+        {"joint0": play, "joint1": play},
+        RetrofitOptions(contact_mode="exact", measure_speed=False, sizing_duration=0.3),
+    )
+    assert (r.model.npair, r.model.nplugin) == (0, 2)
+    assert r.model.ngeom == r.twin.ngeom  # no journal, no ring
+    write_retrofit(r, tmp_path, source_dir=path.parent)
+    assert "compiled plugin instance `clr_joint0__contact`" in (tmp_path / "retrofit.md").read_text()
+    res = simulate_retrofitted(load_retrofitted(tmp_path), SineControl(), 0.1)
+    K = bearing_stiffness(play.clearance)
+    for name, j in res.joints.items():
+        assert j.penetration.max() > 0, f"{name}: no contact, the checks below say nothing"
+        # at the deepest row the approach speed is ~0 (a sampled maximum): the law's force is the
+        # Hertz term K delta^1.5; the step's share of the approach (h |delta''| ~ 1e-3 of the
+        # LN factor's scale) leaves it within 2 %
+        k = int(np.argmax(j.penetration))
+        assert j.force_magnitude[k] == pytest.approx(K * j.penetration[k] ** 1.5, rel=0.02)
+        # frictionless: the force on the journal points to the bearing centre
+        e = j.eccentricity[k] / np.hypot(*j.eccentricity[k])
+        assert j.contact_force[k] @ e == pytest.approx(-j.force_magnitude[k], rel=1e-9)

@@ -108,7 +108,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         default="calibrated",
         choices=("calibrated", "nominal", "exact"),
         help="calibrated (default: the ring's soft contact fitted to the law at each bearing's effective mass, "
-        "cached) or nominal (formula parameters); exact is not available for retrofits yet",
+        "cached), nominal (the ring with formula parameters) or exact (no ring: the compiled plugin's exact "
+        "contact; the written model then needs the plugin, which opens it wherever clearance is installed)",
     )
     num.add_argument(
         "--timestep-us",

@@ -18,12 +18,20 @@ import mujoco
 
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.bearing_geoms import Placement, RingElements, add_journal_and_bearing
+from clearance.model import Clearance
 from clearance.options import ModelOptions
 from clearance.retrofit.elements import rebuild_hinge_after_slides
 from clearance.retrofit.frames import BearingFrame
 from clearance.retrofit.play import PREFIX
 
-__all__ = ["PlayElements", "prefix_of", "add_slides_and_sites", "add_bearing"]
+__all__ = [
+    "PlayElements",
+    "prefix_of",
+    "add_slides_and_sites",
+    "add_bearing",
+    "add_exact_contact",
+    "exact_contact_name",
+]
 
 _SITE_SIZE = [0.001, 0.0, 0.0]
 _SENS = mujoco.mjtSensor
@@ -139,17 +147,44 @@ def add_bearing(
     elements.journal_geom = added.journal.name
     elements.segments = [g.name for g in added.segments]
     elements.pairs = [p.name for p in added.pairs]
-    ecc = spec.add_sensor(
-        name=f"{prefix}__ecc",
-        type=_SENS.mjSENS_FRAMEPOS,
-        objtype=_OBJ.mjOBJ_SITE,
-        objname=elements.journal_site,
-    )
-    ecc.reftype = _OBJ.mjOBJ_SITE
-    ecc.refname = elements.bearing_site
+    ecc = _eccentricity_sensor(spec, elements)
     force = spec.add_sensor(
         name=f"{prefix}__force", type=_SENS.mjSENS_CONTACT, objtype=_OBJ.mjOBJ_GEOM, objname=added.journal.name
     )
     force.intprm[:3] = [2, 3, 1]  # data = force, reduce = netforce, num = 1
     elements.sensors = [ecc.name, force.name]
     return added
+
+
+def _eccentricity_sensor(spec: mujoco.MjSpec, elements: PlayElements) -> mujoco.MjsSensor:
+    ecc = spec.add_sensor(
+        name=f"{prefix_of(elements.hinge)}__ecc",
+        type=_SENS.mjSENS_FRAMEPOS,
+        objtype=_OBJ.mjOBJ_SITE,
+        objname=elements.journal_site,
+    )
+    ecc.reftype = _OBJ.mjOBJ_SITE
+    ecc.refname = elements.bearing_site
+    return ecc
+
+
+def exact_contact_name(hinge: str) -> str:
+    """Name of a hinge's compiled exact contact (plugin instance and its sensor)."""
+    return f"{prefix_of(hinge)}__contact"
+
+
+def add_exact_contact(spec: mujoco.MjSpec, elements: PlayElements, clearance: Clearance) -> None:
+    """Add the compiled exact contact of one hinge (no ring, no journal geom) and the eccentricity
+    sensor; fills ``elements``' sensors (eccentricity, then the plugin's sensor).
+
+    Raises:
+        clearance.contact_plugin.PluginUnavailableError: the plugin is not installed.
+    """
+    from clearance.contact_plugin.attributes import add_for_clearance
+
+    ecc = _eccentricity_sensor(spec, elements)
+    name = exact_contact_name(elements.hinge)
+    add_for_clearance(
+        spec, clearance, name=name, journal_site=elements.journal_site, bearing_site=elements.bearing_site
+    )
+    elements.sensors = [ecc.name, name]

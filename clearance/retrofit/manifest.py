@@ -36,7 +36,7 @@ class HingeRecord:
         radial_clearance: c [m].
         bearing_radius: R_B [m].
         penetration_limit: divergence bound [m] (4 x the Hertz penetration of the sized impact).
-        segments: ring segments.
+        segments: ring segments (0: the compiled exact contact, whose sensor is ``force_sensor``).
     """
 
     name: str

@@ -23,12 +23,12 @@ from clearance.contact_calibration.fit import GOALS
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.spec import ring_geometry
 from clearance.model import Joint, JointType
-from clearance.options import ContactMode, GeomType, ModelOptions
+from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
 from clearance.retrofit.contact import PlayContact, play_contact, row_inverse_weight, write_pair_contact
 from clearance.retrofit.coordinates import CoordinateMap, check_map, coordinate_map, extend_keyframes
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.frames import BearingFrame, bearing_frame
-from clearance.retrofit.insertion import PlayElements, add_bearing, add_slides_and_sites
+from clearance.retrofit.insertion import PlayElements, add_bearing, add_exact_contact, add_slides_and_sites
 from clearance.retrofit.motion import Motion, twin_motion
 from clearance.retrofit.play import RadialPlay, RetrofitError, RetrofitOptions
 from clearance.retrofit.selection import Hinge, compile_model, model_label, select_hinges
@@ -42,7 +42,10 @@ from clearance.retrofit.sizing import (
 )
 from clearance.retrofit.speed import SpeedCost, measure_speed
 
-__all__ = ["RetrofittedHinge", "Retrofit", "retrofit", "INTEGRATORS"]
+__all__ = ["RetrofittedHinge", "Retrofit", "retrofit", "INTEGRATORS", "EXACT_SOURCE"]
+
+EXACT_SOURCE = "exact: compiled plugin clearance.journal_bearing"
+"""The contact source of a hinge in the exact mode (its stiffness is the Hertz-type K)."""
 
 INTEGRATORS = {
     mujoco.mjtIntegrator.mjINT_EULER: "euler",
@@ -63,10 +66,11 @@ class RetrofittedHinge:
         hinge: where it sits (joint and body ids, the same in both models).
         frame: its bearing frame.
         elements: names of what was added for it.
-        ring: the ring's geometry.
+        ring: the ring's geometry (None in the exact mode: no ring).
         mass: effective mass over the motion.
         sizing: loads, sizes, segment count and contact frequency.
-        contact: contact parameters and their source.
+        contact: contact parameters and their source (exact mode: the law's stiffness K
+            [N/m^1.5] and no damping parameter; the plugin computes the law's own).
         model_options: the options its ring was built and calibrated with (segments, geoms,
             time step, integrator, impedance, contact mode).
     """
@@ -76,7 +80,7 @@ class RetrofittedHinge:
     hinge: Hinge
     frame: BearingFrame
     elements: PlayElements
-    ring: RingGeometry
+    ring: RingGeometry | None
     mass: PlayMass
     sizing: PlaySizing
     contact: PlayContact
@@ -179,9 +183,14 @@ def retrofit(
         CalibrationStabilityError: a fitted contact unstable at the time step.
     """
     options = options or RetrofitOptions()
+    exact = options.contact_mode is ContactMode.EXACT
     clock = _Clock()
     with clock("checks"):
         _check_plays(joints)
+        if exact:
+            from clearance.contact_plugin import require as require_plugin
+
+            require_plugin()  # before any work: without the compiled plugin this mode cannot run
         twin_spec = spec.copy()
         twin = compile_model(twin_spec)
         hinges = select_hinges(twin_spec, twin, list(joints))
@@ -222,7 +231,7 @@ def retrofit(
                 joints[h.name].clearance,
                 motion.load_size(h.name),
                 masses[h.name],
-                segments=options.segments,
+                segments=0 if exact else options.segments,  # the exact contact has no ring
                 ripple_limit=options.ripple_limit,
                 flat=options.segment_geom is GeomType.BOX,
             )
@@ -242,7 +251,7 @@ def retrofit(
     for h in hinges:
         play, sizing = joints[h.name], sizings[h.name]
         model_options = ModelOptions(
-            segments=sizing.segments,
+            segments=sizing.segments or None,  # None: the exact contact, no ring
             journal_geom=options.journal_geom,
             segment_geom=options.segment_geom,
             timestep=step,
@@ -251,6 +260,14 @@ def retrofit(
             ripple_limit=options.ripple_limit,
             impedance=options.impedance,
         )
+        if exact:
+            with clock("spec edit and compiles"):
+                add_exact_contact(work, elements[h.name], play.clearance)
+            contact = PlayContact(ContactParameters(sizing.stiffness, 0.0, source=EXACT_SOURCE))
+            done[h.name] = RetrofittedHinge(
+                h.name, play, h, frames[h.name], elements[h.name], None, masses[h.name], sizing, contact, model_options
+            )
+            continue
         ring = _ring(play, sizing.segments, model_options)
         with clock("contact parameters"):
             contact = play_contact(play.clearance, ring, sizing, model_options, use_cache=options.use_cache)

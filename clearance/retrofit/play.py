@@ -171,9 +171,10 @@ class RetrofitOptions:
     """Numerical choices of a retrofit (not physics).
 
     Attributes:
-        contact_mode: NOMINAL or CALIBRATED (default: the ring's soft contact fitted to the
-            contact law at each bearing's own effective mass and impact speeds). The compiled
-            exact contact is not offered for retrofits yet.
+        contact_mode: CALIBRATED (default: the ring's soft contact fitted to the contact law
+            at each bearing's own effective mass and impact speeds), NOMINAL (the ring with
+            formula parameters) or EXACT (no ring: the compiled plugin's exact journal-bearing
+            contact, `clearance.contact_plugin`; the written model then needs the plugin).
         segments: ring segments N per bearing; None: the ripple rule
             (`clearance.mjcf.choose_segments`) at each bearing's typical penetration.
         journal_geom, segment_geom: geom types of journal and segments.
@@ -205,12 +206,9 @@ class RetrofitOptions:
         try:
             mode = ContactMode(self.contact_mode)
         except ValueError:
-            raise RetrofitError(f"contact_mode must be 'nominal' or 'calibrated' (got {self.contact_mode!r})") from None
-        if mode is ContactMode.EXACT:
             raise RetrofitError(
-                "contact_mode 'exact' (the compiled exact contact) is not available for retrofits yet; "
-                "use 'calibrated' (the portable ring)"
-            )
+                f"contact_mode must be 'calibrated', 'nominal' or 'exact' (got {self.contact_mode!r})"
+            ) from None
         object.__setattr__(self, "contact_mode", mode)
         if self.segments is not None:
             if not isinstance(self.segments, int) or isinstance(self.segments, bool) or self.segments < 8:

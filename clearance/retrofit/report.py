@@ -53,7 +53,7 @@ def _added(h: RetrofittedHinge) -> list[str]:
     el = h.elements
     n = len(el.segments)
     axes = h.frame.axes
-    return [
+    head = [
         f"### {h.name}",
         "",
         f"- joints: slides `{el.slides[0]}` (axis {_vec(axes[:, 0])}) and `{el.slides[1]}` (axis "
@@ -62,6 +62,18 @@ def _added(h: RetrofittedHinge) -> list[str]:
         "and its default class",
         f"- sites: `{el.journal_site}` (body {el.journal_body}), `{el.bearing_site}` (body {el.bearing_body}, at "
         f"{_vec(np.asarray(h.frame.bearing.origin))} in its frame), both with the bearing frame's axes",
+    ]
+    if h.ring is None:
+        return [
+            *head,
+            f"- contact: the compiled plugin instance `{el.sensors[1]}` (clearance.journal_bearing) between the two "
+            "sites: the exact circle geometry and the contact law, no geoms and no pairs",
+            f"- sensors: `{el.sensors[0]}` (journal centre in the bearing frame), `{el.sensors[1]}` (the plugin's "
+            "normal and tangential force, penetration, approach speed, work)",
+            "",
+        ]
+    return [
+        *head,
         f"- geoms: journal `{el.journal_geom}` (body {el.journal_body}); {n} ring segments `{el.segments[0]}` … "
         f"`{el.segments[-1]}` (body {el.bearing_body}); all massless, contype = conaffinity = 0",
         f"- pairs: {n}, `{el.pairs[0]}` … `{el.pairs[-1]}`, journal against each segment only",
@@ -128,7 +140,7 @@ def _speed_rows(r: Retrofit) -> list[str]:
 def _kept(r: Retrofit, asset_changes: list[str]) -> list[str]:
     t, m = r.twin, r.model
     nh = len(r.hinges)
-    n_geoms = sum(1 + len(h.elements.segments) for h in r.hinges.values())
+    n_geoms = sum(1 + len(h.elements.segments) for h in r.hinges.values() if h.ring is not None)
     assets = "; ".join(asset_changes) if asset_changes else "no asset folder needed rewriting"
     return [
         f"- bodies: {t.nbody} → {m.nbody}; every body's mass, inertia and inertial frame compiled equal "

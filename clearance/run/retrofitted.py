@@ -28,11 +28,13 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
+from clearance.contact_plugin.attributes import sensor_offsets
 from clearance.results import JointResult, SimulationResult
 from clearance.retrofit.drive import Drive, drive_controls
 from clearance.retrofit.manifest import HingeRecord, RetrofitManifest, read_manifest
 from clearance.retrofit.motion import initial_data
 from clearance.retrofit.play import RetrofitError
+from clearance.run.readout import _exact_contact_force
 from clearance.run.simulation import SimulationError, StepFailure, model_stepper
 from clearance.version import __version__
 
@@ -247,7 +249,8 @@ class _Reader:
             return int(mujoco.mj_name2id(model, kind, name))
 
         self.ecc = {hr.name: sensor(hr.eccentricity_sensor) for hr in hinges}
-        self.force = {hr.name: sensor(hr.force_sensor) for hr in hinges}
+        self.exact = {hr.name: sensor_offsets(model, hr.force_sensor) for hr in hinges if hr.segments == 0}
+        self.force = {hr.name: sensor(hr.force_sensor) for hr in hinges if hr.segments > 0}
         self.bearing_site = {hr.name: jid(mujoco.mjtObj.mjOBJ_SITE, hr.bearing_site) for hr in hinges}
         self.slide_dof = {
             hr.name: [int(model.jnt_dofadr[jid(mujoco.mjtObj.mjOBJ_JOINT, s)]) for s in hr.slides] for hr in hinges
@@ -278,10 +281,13 @@ class _Reader:
             e = sens[:, self.ecc[hr.name]][:, :2].copy()
             rate = v[:, self.slide_dof[hr.name]]
             pen = np.hypot(e[:, 0], e[:, 1]) - hr.radial_clearance
-            # the sensor names only the journal geom, so it reads the force the journal exerts on
-            # the ring: the force on the journal is its opposite
-            f_world = -sens[:, self.force[hr.name]]
-            f = np.einsum("nji,nj->ni", bearing_rot[hr.name], f_world)[:, :2]
+            if hr.name in self.exact:  # the plugin's normal and tangential force, in the bearing frame
+                f = _exact_contact_force(sens, self.exact[hr.name], e)
+            else:
+                # the sensor names only the journal geom, so it reads the force the journal exerts on
+                # the ring: the force on the journal is its opposite
+                f_world = -sens[:, self.force[hr.name]]
+                f = np.einsum("nji,nj->ni", bearing_rot[hr.name], f_world)[:, :2]
             joints[hr.name] = JointResult(e, rate, pen, f)
         outputs = {}
         for k, s in enumerate(self.sites):
