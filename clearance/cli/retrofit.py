@@ -281,7 +281,8 @@ def command(args: argparse.Namespace) -> int:
     for h in result.hinges.values():
         s = h.sizing
         print(
-            f"{h.name}: c = {h.play.clearance.radial_clearance * 1e3:g} mm, {s.segments} segments, effective mass "
+            f"{h.name}: c = {h.play.clearance.radial_clearance * 1e3:g} mm, "
+            f"{f'{s.segments} segments' if s.segments else 'no ring'}, effective mass "
             f"{s.effective_mass:.3g} kg, peak load {s.peak_load:.3g} N, contact {h.contact.parameters.source}"
         )
     print(f"time step {result.timestep:g} s (the model's own {result.twin.opt.timestep:g} s)")
