@@ -89,3 +89,27 @@ def test_first_impact_and_orbit_match_the_native_clearance_run(runs):
     # both impacts of the window happen in both runs
     starts = [np.nonzero(np.diff((j.penetration > 0).astype(int)) == 1)[0] for j in (ja, jb)]
     assert len(starts[0]) == len(starts[1]) >= 2
+
+
+def test_cli_sizes_from_a_control_file(runs, tmp_path, capsys):
+    """`--sizing-control`: the slider-crank's ideal twin sized under its speed set point from a CSV, as the
+    native model sizes its bearing (the sinusoid would hold the servo near 0 rad/s)."""
+    from clearance.cli import main
+
+    a, _, _, r = runs
+    model = tmp_path / "slider_crank_ideal.xml"
+    model.write_text(r.twin_spec.to_xml())
+    ctrl = tmp_path / "ctrl.csv"
+    ctrl.write_text(f"time_s,crank\n0,{float(r.twin.key_ctrl[0, 0])!r}\n")
+    argv = ["retrofit", str(model), "--joint", "crank_rod:clearance_mm=0.5", "--out", str(tmp_path / "out")]
+    argv += ["--contact-mode", "nominal", "--segments", "104", "--timestep-us", "2", "--no-speed"]
+    argv += ["--sizing-control", str(ctrl), "--sizing-duration-s", "0.012"]
+    assert main(argv) == 0
+    stdout = capsys.readouterr().out
+    peak = float(stdout.split("peak load ")[1].split(" N")[0])
+    # the same motion as the native sizing's: its peak load to the printed 3 digits
+    assert peak == pytest.approx(a.metadata["sizing"]["crank_rod"]["peak_load"], rel=5e-3)
+    ctrl.write_text("time_s,crank,extra\n0,1,2\n")
+    assert main([*argv[:4], "--out", str(tmp_path / "never"), "--sizing-control", str(ctrl)]) == 2
+    assert "unknown actuator 'extra'" in capsys.readouterr().err
+    assert not (tmp_path / "never").exists()

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -134,6 +135,13 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--sine-frequency-hz", type=positive(float, "--sine-frequency-hz"), default=1.0, help="[Hz] (default 1)"
     )
     motion.add_argument(
+        "--sizing-control",
+        default=None,
+        metavar="CTRL.csv",
+        help="size from the motion under this control file instead of the sinusoid (header time_s and one column "
+        "per actuator, its name or #k; linear in between, held beyond): a servo's set point, a recorded sequence",
+    )
+    motion.add_argument(
         "--sizing-duration-s", type=positive(float, "--sizing-duration-s"), default=1.0, help="[s] (default 1)"
     )
     p.add_argument("--no-speed", action="store_true", help="do not measure the speed cost")
@@ -234,6 +242,7 @@ def _command_line(args: argparse.Namespace) -> str:
         "--segment-geom",
         "--sine-amplitude",
         "--sine-frequency-hz",
+        "--sizing-control",
         "--sizing-duration-s",
     ):
         value = getattr(args, flag[2:].replace("-", "_"))
@@ -257,7 +266,7 @@ def command(args: argparse.Namespace) -> int:
         journal_geom=args.journal_geom,
         segment_geom=args.segment_geom,
         timestep=None if args.timestep_us is None else si(args.timestep_us, "us"),
-        control=SineControl(args.sine_amplitude, args.sine_frequency_hz),
+        control=SineControl(args.sine_amplitude, args.sine_frequency_hz),  # or the control file, read below
         sizing_duration=args.sizing_duration_s,
         measure_speed=not args.no_speed,
     )
@@ -270,6 +279,14 @@ def command(args: argparse.Namespace) -> int:
     except ValueError as err:
         raise ValueError(f"model file {path} cannot be read by MuJoCo: {err}") from None
     check_steps(args.sizing_duration_s, spec.option.timestep, f"--sizing-duration-s {args.sizing_duration_s:g}")
+    if args.sizing_control is not None:
+        from clearance.retrofit.drive import actuator_labels, read_control_file
+
+        try:
+            labels = actuator_labels(spec.compile())
+        except ValueError as err:
+            raise ValueError(f"model file {path} does not compile: {err}") from None
+        options = replace(options, control=read_control_file(args.sizing_control, labels))
     with folder_lock(out):
         try:
             result = retrofit(spec, plays, options)
