@@ -231,7 +231,8 @@ def plot_contact_force(
         drawn[-1][0].set_xlabel("time [ms]")
     handles = [Patch(facecolor="white", edgecolor="0.6", label="free flight")]
     handles += [Patch(color=MODE_COLOURS[m], alpha=0.4, label=m.value.replace("_", " ")) for m in list(ContactMode)[1:]]
-    handles.append(Patch(color="0.85", label="start-up window"))
+    if startup > 0:  # a run without a start-up window (a retrofitted model) has no span to name
+        handles.append(Patch(color="0.85", label="start-up window"))
     fig.legend(
         handles=handles, loc="upper left", ncol=4, fontsize=8, frameon=False, bbox_to_anchor=(0.08, 1 - 0.42 / h)
     )
@@ -283,7 +284,8 @@ def plot_orbit(
         idx = late[part == k]
         if len(idx):
             idx = np.concatenate([idx, late[part == k + 1][:1]])  # joined to the next span
-            ax.plot(e[idx, 0], e[idx, 1], color=cmap(k), lw=0.9, label="steady state" if k == 0 else None)
+            label = ("steady state" if startup > 0 else "run") if k == 0 else None
+            ax.plot(e[idx, 0], e[idx, 1], color=cmap(k), lw=0.9, label=label)
     ax.plot(e[0, 0], e[0, 1], "o", color="C3", ms=5, label="start")
     bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), cax=cax, label="time [ms]")
     bar.set_ticks(edges[::3].tolist())
