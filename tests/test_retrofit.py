@@ -8,13 +8,13 @@ seconds; a steel bearing on these light links needs 0.5-1 µs (benchmarks/retrof
 
 from __future__ import annotations
 
-import importlib.util
 import math
 from pathlib import Path
 
 import mujoco
 import numpy as np
 import pytest
+from gym_assets import gym_model
 
 from clearance.cli import main
 from clearance.model import Material
@@ -26,13 +26,6 @@ from clearance.retrofit.speed import run_controlled
 
 POLYMER = Material(2.4e9, 0.4)
 NUMERICS = RetrofitOptions(contact_mode="nominal", segments=32, measure_speed=False)
-
-
-def _gym_model(name: str) -> Path:
-    spec = importlib.util.find_spec("gymnasium")
-    if spec is None or not spec.submodule_search_locations:
-        pytest.skip("gymnasium is not installed (pip install -e '.[test]' installs it)")
-    return Path(next(iter(spec.submodule_search_locations))) / "envs" / "mujoco" / "assets" / f"{name}.xml"
 
 
 def _hinges(model: mujoco.MjModel) -> list[str]:
@@ -50,7 +43,7 @@ def _bushing() -> RadialPlay:
 @pytest.fixture(scope="module", params=["reacher", "pusher"])
 def gym(request):
     """(twin spec, the retrofit of every hinge) of a gymnasium model."""
-    spec = mujoco.MjSpec.from_file(str(_gym_model(request.param)))
+    spec = mujoco.MjSpec.from_file(str(gym_model(request.param)))
     hinges = _hinges(spec.compile())
     return spec, retrofit(spec, {h: _bushing() for h in hinges}, NUMERICS)
 
@@ -434,7 +427,7 @@ def test_cli_refuses_a_missing_or_broken_model_file(tmp_path, capsys):
 
 def test_cli_retrofits_the_reacher_calibrated(tmp_path, capsys):
     """The command end to end, calibrated (one fit, cached for the session), with the speed cost."""
-    model = _gym_model("reacher")
+    model = gym_model("reacher")
     out = tmp_path / "reacher"
     argv = ["retrofit", str(model), "--joint", "joint1", "--out", str(out)]
     argv += ["--clearance-mm", "0.2", "--youngs-modulus-gpa", "2.4", "--poisson-ratio", "0.4", "--segments", "32"]

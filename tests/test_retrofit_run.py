@@ -12,6 +12,7 @@ import shutil
 import mujoco
 import numpy as np
 import pytest
+from gym_assets import gym_model
 
 from clearance.analysis.metrics.site_deviation import site_deviation
 from clearance.cli import main
@@ -21,7 +22,6 @@ from clearance.retrofit import RadialPlay, RetrofitError, RetrofitOptions, SineC
 from clearance.retrofit.drive import ControlTable, actuator_labels, drive_controls, read_control_file
 from clearance.run.retrofitted import load_retrofitted, simulate_retrofitted
 from clearance.run.simulation import SimulationError
-from tests.test_retrofit import _gym_model
 
 POLYMER = Material(2.4e9, 0.4)
 
@@ -29,7 +29,7 @@ POLYMER = Material(2.4e9, 0.4)
 @pytest.fixture(scope="module")
 def folder(tmp_path_factory):
     """A written retrofit of the reacher, both hinges."""
-    path = _gym_model("reacher")
+    path = gym_model("reacher")
     spec = mujoco.MjSpec.from_file(str(path))
     play = RadialPlay.make(2e-4, 0.01, bearing_material=POLYMER, journal_material=POLYMER)
     r = retrofit(
@@ -224,7 +224,7 @@ def test_an_unknown_site_is_refused_by_the_function_too(folder):
 
 
 def test_rerun_recording_holds_the_bodies_of_both_models_and_the_orbits(folder, tmp_path, capsys):
-    from tests.test_rerun import F32_RTOL, _read, _view_names
+    from test_rerun import F32_RTOL, _read, _view_names
 
     out = tmp_path / "run"
     rrd = tmp_path / "run.rrd"
@@ -260,7 +260,7 @@ def test_exact_mode_retrofit_runs_with_the_compiled_contact(tmp_path):
 
     if not is_available():
         pytest.skip("the compiled contact plugin is not built")
-    path = _gym_model("reacher")
+    path = gym_model("reacher")
     play = RadialPlay.make(2e-4, 0.01, bearing_material=POLYMER, journal_material=POLYMER)
     r = retrofit(
         mujoco.MjSpec.from_file(str(path)),
