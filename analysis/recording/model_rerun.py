@@ -35,8 +35,9 @@ from clearance.analysis.recording.rerun_log import (
     _force_colors,
     _ns,
     _scalars,
+    recording_file,
 )
-from clearance.results import SimulationResult, temporary_file_beside
+from clearance.results import SimulationResult
 
 __all__ = ["record_model_run"]
 
@@ -175,14 +176,9 @@ def record_model_run(
         raise ValueError("record_model_run needs results with body poses (runs of clearance.run.retrofitted)")
     if max_rate_hz is not None and not (math.isfinite(max_rate_hz) and max_rate_hz > 0):
         raise ValueError(f"max_rate_hz must be > 0 or None (got {max_rate_hz!r})")
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = temporary_file_beside(path)
-    os.close(fd)
-    rec = rr.RecordingStream("clearance")
     hinges = list(result.joints)
-    try:
-        rec.save(str(tmp), default_blueprint=_blueprint(hinges, deviation.site if deviation else None))
+    blueprint = _blueprint(hinges, deviation.site if deviation else None)
+    with recording_file(path, blueprint) as rec:
         _log_bodies(rec, "model", model, result, _display_rows(result.times, max_rate_hz), grey=False)
         _log_bodies(rec, "twin", twin_model, twin, _display_rows(twin.times, max_rate_hz), grey=True)
         _log_orbits(rec, result)
@@ -194,11 +190,4 @@ def record_model_run(
                 deviation.distance * 1e3,
                 f"{deviation.site} |p - p_twin| [mm]",
             )
-        rec.flush()
-        rec.disconnect()
-        os.replace(tmp, path)
-    except BaseException:
-        rec.disconnect()
-        Path(tmp).unlink(missing_ok=True)
-        raise
-    return path
+    return Path(path)

@@ -36,7 +36,8 @@ from __future__ import annotations
 
 import math
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -51,6 +52,7 @@ __all__ = [
     "DEFAULT_MAX_RATE_HZ",
     "REV_TIMELINE",
     "TIME_TIMELINE",
+    "recording_file",
     "LoggedRun",
     "log_run",
     "make_blueprint",
@@ -539,15 +541,34 @@ def record_runs(
         raise ValueError(f"runs must have distinct prefixes (got {prefixes})")
     if max_rate_hz is not None and not (math.isfinite(max_rate_hz) and max_rate_hz > 0):
         raise ValueError(f"max_rate_hz must be > 0 or None (got {max_rate_hz!r})")
+    with recording_file(path, make_blueprint(runs), application_id) as rec:
+        for r in runs:
+            log_run(rec, r, max_rate_hz=max_rate_hz)
+    return Path(path)
+
+
+@contextmanager
+def recording_file(
+    path: str | os.PathLike[str], blueprint: rrb.Blueprint, application_id: str = "clearance"
+) -> Iterator[rr.RecordingStream]:
+    """A recording stream saved to ``path`` atomically: in place when the block ends, nothing on error.
+
+    Args:
+        path: the ``.rrd`` file (its folder is created).
+        blueprint: the recording's default layout.
+        application_id: rerun application id.
+
+    Yields:
+        The stream to log to.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = temporary_file_beside(path)  # the usual mode of a new file, not mkstemp's 0o600
     os.close(fd)
     rec = rr.RecordingStream(application_id)
     try:
-        rec.save(str(tmp), default_blueprint=make_blueprint(runs))
-        for r in runs:
-            log_run(rec, r, max_rate_hz=max_rate_hz)
+        rec.save(str(tmp), default_blueprint=blueprint)
+        yield rec
         rec.flush()
         rec.disconnect()
         os.replace(tmp, path)
@@ -555,7 +576,6 @@ def record_runs(
         rec.disconnect()
         Path(tmp).unlink(missing_ok=True)
         raise
-    return path
 
 
 def record(
