@@ -314,7 +314,7 @@ def test_everything_else_of_the_kit_model_is_kept(kit_retrofit, tmp_path, kit):
         ("socket", "joint 'socket' is a ball joint"),
         ("float", "joint 'float' is a free joint"),
         ("swivel", "shares body 'carriage' with other joints (rail)"),
-        ("loop", "'loop' is a connect equality (a loop closure)"),
+        ("loop", "connect 'loop' of model 'kit_arm': neither body (loose, world) has a hinge"),
         ("wrist", "joint 'wrist' does not exist in model 'kit_arm'; its named hinges are: shoulder, elbow, swivel"),
     ],
 )

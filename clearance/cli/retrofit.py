@@ -57,7 +57,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         action="append",
         required=True,
         metavar="NAME[:key=value,...]",
-        help="a hinge to give radial play (repeat for more); its own values may follow, keys " + ", ".join(JOINT_KEYS),
+        help="a hinge, or a loop closure's connect equality, to give radial play (repeat for more); its own values "
+        "may follow, keys " + ", ".join(JOINT_KEYS),
     )
     p.add_argument("--out", required=True, metavar="DIR", help="output folder")
     play = p.add_argument_group("play (every hinge, unless its --joint says otherwise)")

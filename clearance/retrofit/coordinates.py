@@ -64,33 +64,42 @@ class CoordinateMap:
         return v
 
 
-def coordinate_map(twin: mujoco.MjModel, hinges: Mapping[str, int]) -> CoordinateMap:
-    """Where the unmodified coordinates go once each hinge in ``hinges`` gets two slides before it.
+def coordinate_map(
+    twin: mujoco.MjModel, hinges: Mapping[str, int], pins: Mapping[str, int] | None = None
+) -> CoordinateMap:
+    """Where the unmodified coordinates go once each hinge in ``hinges`` gets two slides before it
+    and each loop closure in ``pins`` a pin with two slides.
 
     Compiled joints follow the body tree and each body's joint order, so every joint moves
-    by two places per retrofitted hinge at or before it (a hinge's own slides come first).
+    by two places per pair of slides inserted at or before it (a hinge's own slides come
+    first; a pin's slides come before the joint given, after every joint of its body's subtree).
 
     Args:
         twin: the unmodified model.
         hinges: hinge name -> its joint id in ``twin``.
+        pins: loop closure name -> the joint id in ``twin`` its pin's slides come before
+            (``njnt``: at the end; `clearance.retrofit.loop.pin_insertion_joint`).
     """
-    ids = sorted(hinges.values())
+    inserts = sorted(
+        [(j, 1, n) for n, j in hinges.items()] + [(j, 0, n) for n, j in (pins or {}).items()],
+    )
     qpos = np.zeros(twin.nq, dtype=int)
     qvel = np.zeros(twin.nv, dtype=int)
     for j in range(twin.njnt):
         kind = mujoco.mjtJoint(int(twin.jnt_type[j]))
-        shift = 2 * sum(1 for h in ids if h <= j)
+        shift = 2 * sum(1 for at, _, _ in inserts if at <= j)
         a = int(twin.jnt_qposadr[j])
         qpos[a : a + _NQ[kind]] = np.arange(a, a + _NQ[kind]) + shift
         a = int(twin.jnt_dofadr[j])
         qvel[a : a + _NV[kind]] = np.arange(a, a + _NV[kind]) + shift
+    slide_qpos, slide_dof = {}, {}
+    for k, (at, _, name) in enumerate(inserts):
+        base_q = int(twin.jnt_qposadr[at]) if at < twin.njnt else int(twin.nq)
+        base_v = int(twin.jnt_dofadr[at]) if at < twin.njnt else int(twin.nv)
+        slide_qpos[name] = base_q + 2 * k + np.array([0, 1])
+        slide_dof[name] = base_v + 2 * k + np.array([0, 1])
     return CoordinateMap(
-        qpos,
-        qvel,
-        {n: qpos[twin.jnt_qposadr[j]] - np.array([2, 1]) for n, j in hinges.items()},
-        {n: qvel[twin.jnt_dofadr[j]] - np.array([2, 1]) for n, j in hinges.items()},
-        int(twin.nq) + 2 * len(ids),
-        int(twin.nv) + 2 * len(ids),
+        qpos, qvel, slide_qpos, slide_dof, int(twin.nq) + 2 * len(inserts), int(twin.nv) + 2 * len(inserts)
     )
 
 

@@ -17,7 +17,7 @@ import numpy as np
 
 from clearance.mjcf.bearing_geoms import Placement
 
-__all__ = ["BearingFrame", "bearing_frame", "in_plane_axes"]
+__all__ = ["BearingFrame", "bearing_frame", "in_plane_axes", "placement"]
 
 
 def in_plane_axes(axis: np.ndarray) -> np.ndarray:
@@ -36,6 +36,11 @@ def _quat(rotation: np.ndarray) -> tuple[float, float, float, float]:
     q = np.zeros(4)
     mujoco.mju_mat2Quat(q, np.ascontiguousarray(rotation, dtype=float).reshape(9))
     return (float(q[0]), float(q[1]), float(q[2]), float(q[3]))
+
+
+def placement(origin: np.ndarray, rotation: np.ndarray) -> Placement:
+    """A placement at ``origin`` (3,) whose axes are the columns of ``rotation`` (3, 3)."""
+    return Placement((float(origin[0]), float(origin[1]), float(origin[2])), _quat(rotation))
 
 
 @dataclass(frozen=True)
@@ -71,8 +76,4 @@ def bearing_frame(model: mujoco.MjModel, data: mujoco.MjData, joint_id: int) -> 
     world_origin = data.xpos[child] + rc @ p
     origin_in_parent = rp.T @ (world_origin - data.xpos[parent])
     axes_in_parent = rp.T @ rc @ axes
-    journal = Placement((float(p[0]), float(p[1]), float(p[2])), _quat(axes))
-    bearing = Placement(
-        (float(origin_in_parent[0]), float(origin_in_parent[1]), float(origin_in_parent[2])), _quat(axes_in_parent)
-    )
-    return BearingFrame(journal, bearing, axes, axes_in_parent)
+    return BearingFrame(placement(p, axes), placement(origin_in_parent, axes_in_parent), axes, axes_in_parent)

@@ -3,9 +3,10 @@
 The unmodified model runs at its own time step from its first keyframe (qpos0 when it has
 none) under `SineControl`. At every step the force each chosen hinge carries in the plane of
 its bearing is read from MuJoCo's ``cfrc_int`` (the force the parent exerts on the child's
-subtree; its translational part is the same about any point): that in-plane load is what
-drives the journal across its clearance once the hinge has play. The load's axial part is
-carried by the hinge itself (planar play only, no tilt).
+subtree; its translational part is the same about any point), a connect's from its
+constraint force: that in-plane load is what drives the journal across its clearance once
+the hinge has play. The load's axial part is carried by the hinge itself (planar play only,
+no tilt).
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import mujoco
 import numpy as np
 
 from clearance.retrofit.frames import BearingFrame
+from clearance.retrofit.loop import connect_load
 from clearance.retrofit.play import ControlTable, RetrofitError, SineControl
 from clearance.retrofit.selection import Hinge
 
@@ -116,6 +118,9 @@ def twin_motion(
             break
         qpos[i] = data.qpos
         for h in hinges:
+            if h.is_connect:
+                loads[h.name][i] = connect_load(data, h.equality_id, h.parent_id, frames[h.name])
+                continue
             world = data.xmat[h.parent_id].reshape(3, 3) @ frames[h.name].axes_in_parent
             f = world.T @ data.cfrc_int[h.child_id, 3:6]
             loads[h.name][i] = f[:2]

@@ -12,6 +12,7 @@ speed cost (`speed`).
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import time
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field
@@ -29,6 +30,7 @@ from clearance.retrofit.coordinates import CoordinateMap, check_map, coordinate_
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.frames import BearingFrame, bearing_frame
 from clearance.retrofit.insertion import PlayElements, add_bearing, add_exact_contact, add_slides_and_sites
+from clearance.retrofit.loop import PIN_ARMATURE_FRACTION, add_pin, connect_frame, pin_insertion_joint
 from clearance.retrofit.motion import Motion, twin_motion
 from clearance.retrofit.play import RadialPlay, RetrofitError, RetrofitOptions
 from clearance.retrofit.selection import Hinge, compile_model, model_label, select_hinges
@@ -143,10 +145,19 @@ def _spec_bodies(spec: mujoco.MjSpec) -> dict[int, mujoco.MjsBody]:
     return {int(b.id): b for b in spec.bodies}
 
 
-def _mass_properties(model: mujoco.MjModel) -> np.ndarray:
+def _mass_properties(model: mujoco.MjModel, bodies: np.ndarray | None = None) -> np.ndarray:
+    """Masses, inertias and inertial frames of ``bodies`` (ids; default all) in one array."""
+    b = np.arange(model.nbody) if bodies is None else bodies
     return np.concatenate(
-        [model.body_mass, model.body_inertia.ravel(), model.body_ipos.ravel(), model.body_iquat.ravel()]
+        [model.body_mass[b], model.body_inertia[b].ravel(), model.body_ipos[b].ravel(), model.body_iquat[b].ravel()]
     )
+
+
+def _in_model(hinge: Hinge, bodies: Mapping[int, mujoco.MjsBody], spec: mujoco.MjSpec, added: PlayElements) -> Hinge:
+    """``hinge`` with the body ids of the last compile of ``spec`` (a pin shifts the bodies after it); a
+    connect's journal body is its pin."""
+    child = spec.body(added.journal_body).id if hinge.is_connect else bodies[hinge.child_id].id
+    return dataclasses.replace(hinge, child_id=int(child), parent_id=int(bodies[hinge.parent_id].id))
 
 
 def _ring(play: RadialPlay, segments: int, options: ModelOptions) -> RingGeometry:
@@ -167,7 +178,9 @@ def retrofit(
     them only. Everything else of the model is kept: bodies, masses and inertias, actuators,
     sensors (new ones are appended), keyframes (extended for the slides), defaults, assets,
     equality constraints, the integrator. The time step becomes the one the stability rule
-    chooses (`clearance.retrofit.sizing`) unless ``options.timestep`` is given.
+    chooses (`clearance.retrofit.sizing`) unless ``options.timestep`` is given. A `connect`
+    equality named instead of a hinge gets a pin on its body2 that the connect ties to body1's
+    anchor, the journal on the pin (`clearance.retrofit.loop`): the one body a retrofit adds.
 
     Args:
         spec: the user's model (not changed: the retrofit edits a copy).
@@ -198,7 +211,12 @@ def retrofit(
     with clock("sizing motion"):
         data = mujoco.MjData(twin)
         mujoco.mj_kinematics(twin, data)
-        frames = {h.name: bearing_frame(twin, data, h.joint_id) for h in hinges}
+        frames = {
+            h.name: connect_frame(twin, data, h.equality_id, h.axis_joint)
+            if h.is_connect
+            else bearing_frame(twin, data, h.joint_id)
+            for h in hinges
+        }
         motion = twin_motion(twin, hinges, frames, options.control, options.sizing_duration)
     if motion.warnings:
         notes.append(
@@ -215,15 +233,24 @@ def retrofit(
         for h in hinges:
             if h.parent_id not in bodies:
                 raise RetrofitError(f"the parent body of hinge '{h.name}' is not in the spec of {model_label(spec)}")
+            if h.is_connect:
+                armature = PIN_ARMATURE_FRACTION * float(twin.body_subtreemass[h.child_id])
+                elements[h.name] = add_pin(work, h.name, bodies[h.parent_id], frames[h.name], armature, cls)
+                continue
             elements[h.name] = add_slides_and_sites(work, work.joint(h.name), bodies[h.parent_id], frames[h.name], cls)
-        cmap = coordinate_map(twin, {h.name: h.joint_id for h in hinges})
+        cmap = coordinate_map(
+            twin,
+            {h.name: h.joint_id for h in hinges if not h.is_connect},
+            {h.name: pin_insertion_joint(twin, h.parent_id) for h in hinges if h.is_connect},
+        )
         offsets = {h.name: joints[h.name].initial_eccentricity for h in hinges}
         nkeys = extend_keyframes(work, twin, cmap, offsets)
         kinematic = compile_model(work)
         check_map(cmap, kinematic, {n: e.slides for n, e in elements.items()})
+        in_model = {h.name: _in_model(h, bodies, work, elements[h.name]) for h in hinges}
 
     with clock("effective masses"):
-        masses = effective_masses(kinematic, cmap, hinges, frames, motion)
+        masses = effective_masses(kinematic, cmap, list(in_model.values()), frames, motion)
     sizings: dict[str, PlaySizing] = {}
     with clock("segment rule"):
         for h in hinges:
@@ -276,7 +303,7 @@ def retrofit(
             added = add_bearing(
                 work,
                 elements[h.name],
-                work.joint(h.name).parent,
+                work.body(elements[h.name].journal_body) if h.is_connect else work.joint(h.name).parent,
                 bodies[h.parent_id],
                 frames[h.name],
                 ring,
@@ -284,7 +311,7 @@ def retrofit(
                 play.clearance.friction,
                 cls,
             )
-            a_hat = row_inverse_weight(kinematic, h.child_id, h.parent_id)
+            a_hat = row_inverse_weight(kinematic, in_model[h.name].child_id, in_model[h.name].parent_id)
             write_pair_contact(added.pairs, contact.parameters, a_hat, play.clearance.radial_clearance)
         done[h.name] = RetrofittedHinge(
             h.name, play, h, frames[h.name], elements[h.name], ring, masses[h.name], sizing, contact, model_options
@@ -292,7 +319,8 @@ def retrofit(
     with clock("spec edit and compiles"):
         work.option.timestep = step
         model = compile_model(work)
-    if not np.array_equal(_mass_properties(model), _mass_properties(twin)):
+    kept = np.array([int(b.id) for _, b in sorted(bodies.items())])
+    if not np.array_equal(_mass_properties(model, kept), _mass_properties(twin)):
         raise RuntimeError("the retrofit changed a body's mass or inertia (new geoms must be massless)")
     speed = None
     if options.measure_speed:

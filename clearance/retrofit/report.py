@@ -5,6 +5,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from clearance.retrofit.loop import CONNECT_IMPEDANCE, PIN_ARMATURE_FRACTION, PIN_INERTIA, PIN_MASS
 from clearance.retrofit.pipeline import Retrofit, RetrofittedHinge
 from clearance.retrofit.play import DEFAULT_CLASS, SineControl
 from clearance.retrofit.sizing import STEP_OMEGA_H
@@ -49,17 +50,42 @@ def _hinge_rows(r: Retrofit) -> list[str]:
     return rows
 
 
-def _added(h: RetrofittedHinge) -> list[str]:
+def _pin(h: RetrofittedHinge, model: mujoco.MjModel) -> list[str]:
+    """The pin and the moved connect of a loop closure."""
+    el, axes = h.elements, h.frame.axes
+    slide = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, el.slides[0])
+    armature = float(model.dof_armature[model.jnt_dofadr[slide]])
+    return [
+        f"- body: the pin `{el.journal_body}`, a child of {el.bearing_body} at the connect's anchor "
+        f"{_vec(np.asarray(h.frame.bearing.origin))} ({el.bearing_body} frame), mass {_g(PIN_MASS)} kg and inertia "
+        f"{_g(PIN_INERTIA)} kg m² (MuJoCo needs a moving body to have them): the one body and mass a retrofit adds",
+        f"- joints: slides `{el.slides[0]}` (axis {_vec(axes[:, 0])}) and `{el.slides[1]}` (axis {_vec(axes[:, 1])}) "
+        f"in the pin, armature {_g(armature)} kg each ({_g(PIN_ARMATURE_FRACTION * 100)} % of the subtree mass of the "
+        "connect's body1): the journal's added mass",
+        f"- equality: the connect `{h.name}` ties body1's anchor to the pin instead of {el.bearing_body}; its solimp "
+        f"d0 = d_width = {_g(CONNECT_IMPEDANCE)} (MuJoCo's largest: a light pin would let a softer connect open), "
+        "every other attribute kept",
+    ]
+
+
+def _added(h: RetrofittedHinge, model: mujoco.MjModel) -> list[str]:
     el = h.elements
     n = len(el.segments)
     axes = h.frame.axes
+    joints = (
+        _pin(h, model)
+        if h.hinge.is_connect
+        else [
+            f"- joints: slides `{el.slides[0]}` (axis {_vec(axes[:, 0])}) and `{el.slides[1]}` (axis "
+            f"{_vec(axes[:, 1])}) in body {el.journal_body}, before the hinge, at the hinge position "
+            f"{_vec(np.asarray(h.frame.journal.origin))} (child frame); the hinge `{h.name}` keeps every attribute "
+            "and its default class",
+        ]
+    )
     head = [
         f"### {h.name}",
         "",
-        f"- joints: slides `{el.slides[0]}` (axis {_vec(axes[:, 0])}) and `{el.slides[1]}` (axis "
-        f"{_vec(axes[:, 1])}) in body {el.journal_body}, before the hinge, at the hinge position "
-        f"{_vec(np.asarray(h.frame.journal.origin))} (child frame); the hinge `{h.name}` keeps every attribute "
-        "and its default class",
+        *joints,
         f"- sites: `{el.journal_site}` (body {el.journal_body}), `{el.bearing_site}` (body {el.bearing_body}, at "
         f"{_vec(np.asarray(h.frame.bearing.origin))} in its frame), both with the bearing frame's axes",
     ]
@@ -144,8 +170,9 @@ def _kept(r: Retrofit, asset_changes: list[str]) -> list[str]:
     assets = "; ".join(asset_changes) if asset_changes else "no asset folder needed rewriting"
     return [
         f"- bodies: {t.nbody} → {m.nbody}; every body's mass, inertia and inertial frame compiled equal "
-        "(checked: new geoms and sites add no mass)",
-        f"- joints: {t.njnt} → {m.njnt} (+2 slides per hinge); nq {t.nq} → {m.nq}, nv {t.nv} → {m.nv}",
+        "(checked: new geoms and sites add no mass)"
+        + (f"; the pins of loop closures are the bodies added ({_g(PIN_MASS)} kg each)" if m.nbody > t.nbody else ""),
+        f"- joints: {t.njnt} → {m.njnt} (+2 slides per hinge or pin); nq {t.nq} → {m.nq}, nv {t.nv} → {m.nv}",
         f"- geoms: {t.ngeom} → {m.ngeom} (+{n_geoms}); sites: {t.nsite} → {m.nsite} (+{2 * nh}); "
         f"pairs: {t.npair} → {m.npair}",
         f"- actuators: {t.nu} → {m.nu}; sensors: {t.nsensor} → {m.nsensor} (+{2 * nh}, after the model's own); "
@@ -174,7 +201,8 @@ def retrofit_report(r: Retrofit, *, source: str = "", command: str = "", asset_c
         lines += ["```", command, "```", ""]
     lines += [
         "**Planar play only: no tilt.** Each journal moves in the plane normal to its hinge axis; it cannot tilt "
-        "in its bearing or move along the axis, which the hinge still holds.",
+        "in its bearing or move along the axis, which the hinge still holds (a loop closure's pin moves in the plane "
+        "normal to the axis of a hinge of its bodies; the connect holds it along that axis).",
         "",
         f"Ring mode (portable MJCF, stock MuJoCo), contact {r.options.contact_mode.value}; "
         f"{r.options.journal_geom.value} journal, {r.options.segment_geom.value} segments.",
@@ -185,7 +213,7 @@ def retrofit_report(r: Retrofit, *, source: str = "", command: str = "", asset_c
         "",
         "## Added",
         "",
-        *[line for h in r.hinges.values() for line in _added(h)],
+        *[line for h in r.hinges.values() for line in _added(h, r.model)],
         "## Sizing",
         "",
         f"From {len(r.motion.times)} steps ({_g(len(r.motion.times) * h0, 3)} s) of the unmodified model at its own "

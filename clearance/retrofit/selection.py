@@ -2,9 +2,10 @@
 
 A hinge can be given radial play when it exists, is a hinge (not a ball, slide or free
 joint), is the only joint of its body, and the model lets contacts act (the bearing is a
-ring of contact pairs). A model that does not compile, or that already holds names with the
-retrofit's prefix, is refused too. Every refusal is one `RetrofitError` naming the joint and
-what was expected.
+ring of contact pairs); a loop closure (a `connect` equality between two bodies) when one of
+its bodies has a hinge to take the axis from (`clearance.retrofit.loop`). A model that does
+not compile, or that already holds names with the retrofit's prefix, is refused too. Every
+refusal is one `RetrofitError` naming the joint and what was expected.
 """
 
 from __future__ import annotations
@@ -14,6 +15,7 @@ from dataclasses import dataclass
 
 import mujoco
 
+from clearance.retrofit.loop import check_connect
 from clearance.retrofit.play import DEFAULT_CLASS, PREFIX, RetrofitError
 
 __all__ = ["Hinge", "compile_model", "select_hinges", "hinge_names"]
@@ -43,18 +45,30 @@ _NAMED = (
 class Hinge:
     """A hinge chosen for radial play, located in the compiled unmodified model.
 
+    A loop closure (a `connect` equality) is one too: its journal is a pin that follows
+    body1's anchor (`clearance.retrofit.loop`), its bearing on body2.
+
     Attributes:
-        name: the joint's name.
-        joint_id: its id in the unmodified model.
-        child_id: the body it moves (the journal's body).
+        name: the joint's (or the connect's) name.
+        joint_id: its id in the unmodified model (-1 for a connect).
+        child_id: the body it moves (the journal's body; a connect's body1).
         parent_id: that body's parent in the compiled model (the bearing's body; 0 for the
-            world).
+            world; a connect's body2).
+        equality_id: the connect's id (-1 for a hinge).
+        axis_joint: the hinge whose axis a connect's play is normal to (-1 for a hinge).
     """
 
     name: str
     joint_id: int
     child_id: int
     parent_id: int
+    equality_id: int = -1
+    axis_joint: int = -1
+
+    @property
+    def is_connect(self) -> bool:
+        """Whether this is a loop closure rather than a hinge."""
+        return self.equality_id >= 0
 
 
 def model_label(spec: mujoco.MjSpec) -> str:
@@ -115,8 +129,8 @@ def select_hinges(spec: mujoco.MjSpec, model: mujoco.MjModel, names: Sequence[st
 
     Raises:
         RetrofitError: no name, a name given twice, a joint that does not exist (the
-            message lists the hinges there are), a connect equality (loop closures are not
-            given play yet), a joint that is not a hinge, a hinge sharing its body with
+            message lists the hinges there are), a connect between sites or between two
+            bodies without a hinge (no axis), a joint that is not a hinge, a hinge sharing its body with
             other joints, contacts or constraints disabled, or names with the retrofit's
             prefix already in the model.
     """
@@ -151,12 +165,14 @@ def select_hinges(spec: mujoco.MjSpec, model: mujoco.MjModel, names: Sequence[st
         if jid < 0:
             eq = mujoco.mj_name2id(model, _OBJ.mjOBJ_EQUALITY, n)
             if eq >= 0 and model.eq_type[eq] == mujoco.mjtEq.mjEQ_CONNECT:
-                raise RetrofitError(
-                    f"'{n}' is a connect equality (a loop closure) of {label}: giving play to loop closures is not "
-                    "supported yet; name a hinge"
-                )
+                b1, b2, axis = check_connect(model, eq, n, label)
+                out.append(Hinge(n, -1, b1, b2, eq, axis))
+                continue
             listed = ", ".join(hinges) if hinges else "none"
-            raise RetrofitError(f"joint '{n}' does not exist in {label}; its named hinges are: {listed}")
+            raise RetrofitError(
+                f"joint '{n}' does not exist in {label}; its named hinges are: {listed} (a connect equality can be "
+                "named too)"
+            )
         kind = mujoco.mjtJoint(int(model.jnt_type[jid]))
         if kind != mujoco.mjtJoint.mjJNT_HINGE:
             raise RetrofitError(
