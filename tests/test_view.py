@@ -184,3 +184,20 @@ def test_a_window_that_cannot_open_is_one_line(capsys, monkeypatch, fake_launch,
     monkeypatch.setattr(mujoco.viewer, "launch", refuse)
     err = one_line_error(capsys, ["view", str(ring_file)])
     assert "cannot open a window (could not initialize GLFW)" in err
+
+
+def test_a_retrofit_folder_opens_its_model_and_with_ideal_its_unmodified_twin(tmp_path):
+    # a folder written by `clearance retrofit` holds model.xml and original.xml (no ideal_model.xml)
+    twin = mujoco.MjSpec.from_string(
+        '<mujoco><worldbody><body name="a"><joint name="h" type="hinge" axis="0 0 1"/>'
+        '<geom type="capsule" fromto="0 0 0 0.1 0 0" size="0.01"/></body></worldbody>'
+        '<keyframe><key qpos="0.3"/></keyframe></mujoco>'
+    )
+    (tmp_path / "original.xml").write_text(twin.to_xml())
+    twin.body("a").add_joint(name="clr_h__x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
+    twin.keys[0].qpos = [0.3, 0.0]  # the stand-in model only needs one more coordinate to tell it apart
+    (tmp_path / "model.xml").write_text(twin.to_xml())
+    model, data = initial_state(tmp_path)
+    assert model.nq == 2 and data.qpos[0] == pytest.approx(0.3, abs=0)  # keyframe 0 applied exactly
+    model, data = initial_state(tmp_path, ideal=True)
+    assert model.nq == 1 and data.qpos[0] == pytest.approx(0.3, abs=0)

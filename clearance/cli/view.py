@@ -29,6 +29,9 @@ RUN_MODEL = "model.xml"
 RUN_IDEAL_MODEL = "ideal_model.xml"
 """The ideal twin's model of a run's folder."""
 
+RETROFIT_TWIN_MODEL = "original.xml"
+"""The unmodified twin of a folder written by `clearance retrofit` (its ``--ideal``)."""
+
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``view`` to the subcommands ``sub`` (argparse's subparsers action)."""
@@ -44,7 +47,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     v.add_argument(
         "--ideal",
         action="store_true",
-        help=f"with a run's folder: open its ideal twin ({RUN_IDEAL_MODEL})",
+        help=f"with a run's folder: open its ideal twin ({RUN_IDEAL_MODEL}; {RETROFIT_TWIN_MODEL} in a folder "
+        "written by 'clearance retrofit')",
     )
     v.set_defaults(run_command=command)
 
@@ -54,7 +58,8 @@ def model_path(path: str | os.PathLike[str], *, ideal: bool = False) -> Path:
 
     Args:
         path: an MJCF file, or a folder written by ``clearance run``.
-        ideal: take the folder's ideal twin (``ideal_model.xml``); refused for a file.
+        ideal: take the folder's ideal twin (``ideal_model.xml``, or ``original.xml`` in a
+            folder written by ``clearance retrofit``); refused for a file.
 
     Raises:
         ValueError: the path does not exist, is a folder without the model, or ``ideal``
@@ -62,9 +67,10 @@ def model_path(path: str | os.PathLike[str], *, ideal: bool = False) -> Path:
     """
     p = Path(path)
     if p.is_dir():
-        name = RUN_IDEAL_MODEL if ideal else RUN_MODEL
+        twin = RETROFIT_TWIN_MODEL if (p / RETROFIT_TWIN_MODEL).is_file() else RUN_IDEAL_MODEL
+        name = twin if ideal else RUN_MODEL
         if not (p / name).is_file():
-            others = [n for n in (RUN_MODEL, RUN_IDEAL_MODEL) if (p / n).is_file()]
+            others = [n for n in (RUN_MODEL, RUN_IDEAL_MODEL, RETROFIT_TWIN_MODEL) if (p / n).is_file()]
             found = f"it holds {', '.join(others)}" if others else "it holds no model"
             raise ValueError(
                 f"clearance view: folder {p} has no {name} ({found}): give a folder written by "
