@@ -126,6 +126,13 @@ def test_a_connect_without_an_axis_is_refused():
         retrofit(spec, {"tie": RadialPlay()}, RetrofitOptions(measure_speed=False))
 
 
+def test_a_connect_with_an_initial_eccentricity_is_refused():
+    spec = mujoco.MjSpec.from_string(_FOUR_BAR)
+    play = RadialPlay.make(1e-4, initial_eccentricity=(5e-5, 0.0))
+    with pytest.raises(RetrofitError, match="connect 'loop': a loop closure's journal starts centred"):
+        retrofit(spec, {"loop": play}, RetrofitOptions(measure_speed=False))
+
+
 _FOUR_BAR = """<mujoco model="four_bar"><option timestep="1e-4" gravity="0 -9.81 0"/>
 <default><geom type="capsule" size="0.005" contype="0" conaffinity="0"/></default>
 <worldbody>

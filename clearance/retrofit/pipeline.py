@@ -207,6 +207,12 @@ def retrofit(
         twin_spec = spec.copy()
         twin = compile_model(twin_spec)
         hinges = select_hinges(twin_spec, twin, list(joints))
+        for h in hinges:
+            if h.is_connect and any(joints[h.name].initial_eccentricity):
+                raise RetrofitError(
+                    f"connect '{h.name}': a loop closure's journal starts centred (its pin sits at body1's anchor, "
+                    f"which the keyframes place); got initial_eccentricity {joints[h.name].initial_eccentricity}"
+                )
     notes: list[str] = []
     with clock("sizing motion"):
         data = mujoco.MjData(twin)

@@ -57,7 +57,8 @@ class RadialPlay:
             body always holds the journal). Defaults: c = 0.1 mm, R_B = 10 mm, steel on
             steel, restitution 0.9, no friction, Lankarani-Nikravesh.
         initial_eccentricity: the journal centre in the bearing frame (x, y) [m] that the
-            model's keyframes start from; (0, 0): centred. Its size must be below c.
+            model's keyframes start from; (0, 0): centred. Its size must be below c; a loop
+            closure's (a connect's) must be (0, 0).
     """
 
     clearance: Clearance = field(default_factory=lambda: Clearance(DEFAULT_RADIAL_CLEARANCE, DEFAULT_BEARING_RADIUS))
