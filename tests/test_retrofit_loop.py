@@ -171,3 +171,16 @@ def test_a_pin_inside_the_tree_with_a_hinge_in_ring_mode(tmp_path):
         j = run.joints[name]
         # both journals strike their bearings under gravity and the drive
         assert np.hypot(*j.eccentricity.T).max() > 1e-4 and (j.penetration > 0).any()
+
+
+def test_cli_retrofits_a_connect(tmp_path, capsys):
+    from clearance.cli import main
+
+    model = tmp_path / "four_bar.xml"
+    model.write_text(_FOUR_BAR)
+    argv = ["retrofit", str(model), "--joint", "loop:clearance_mm=0.2", "--out", str(tmp_path / "out")]
+    argv += ["--contact-mode", "nominal", "--segments", "64", "--sizing-duration-s", "0.05", "--no-speed"]
+    assert main(argv) == 0
+    assert "loop: c = 0.2 mm" in capsys.readouterr().out
+    written = mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "model.xml"))  # stock MuJoCo opens it
+    assert mujoco.mj_name2id(written, mujoco.mjtObj.mjOBJ_BODY, "clr_loop__pin") >= 0
