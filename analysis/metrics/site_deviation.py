@@ -50,6 +50,16 @@ class SiteDeviation:
 def site_deviation(result: SimulationResult, twin: SimulationResult, site: str, *, skip: float = 0.0) -> SiteDeviation:
     """Deviation statistics of ``site`` over the window after ``skip`` [s].
 
+    Args:
+        result: the retrofitted model's run, with the site's outputs ``site/<name>/x|y|z``.
+        twin: the unmodified twin's run (interpolated to ``result``'s times).
+        site: the site (or body) name.
+        skip: start of the window after the run's first time [s].
+
+    Returns:
+        Per moving coordinate the `DeviationStatistics`, and the distance from the twin's
+        position over the window.
+
     Raises:
         KeyError: the site's outputs are not in both runs.
         ValueError: the window holds fewer than 3 samples.
