@@ -560,6 +560,10 @@ def test_a_folder_in_use_is_refused_naming_the_holder(tmp_path, capsys, no_work)
         assert _holder_pid(out / ".clearance.lock") == os.getpid()
 
 
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def _command(*args: str) -> list[str]:
     return [sys.executable, "-m", "clearance.cli", *args]
 
@@ -662,6 +666,9 @@ def test_ctrl_c_stops_a_sweep_with_one_line_and_keeps_its_points(tmp_path):
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,  # its own process group, as a shell gives a command
+        # and Ctrl-C's default action, as a terminal's shell gives it: a test run started in the
+        # background (`cmd &` in a script) ignores SIGINT, and its children would inherit that
+        preexec_fn=_default_sigint,
     )
     deadline = time.monotonic() + 120
     while not list(out.glob("points/point_*.json")):  # the first point is kept
