@@ -33,6 +33,7 @@ from clearance.checks import positive
 from clearance.model import Clearance, ContactLaw, Material
 
 __all__ = [
+    "contact_omega",
     "bearing_stiffness",
     "bearing_stiffness_from",
     "hertz",
@@ -574,3 +575,18 @@ def _friction(fn: ArrayLike, vt: ArrayLike, mu: float, v0: float, v1: float) -> 
     v = np.asarray(vt, dtype=float)
     cd = np.clip((np.abs(v) - v0) / (v1 - v0), 0.0, 1.0)
     return -mu * cd * np.asarray(fn, dtype=float) * np.sign(v) + 0.0  # + 0.0: no -0.0
+
+
+def contact_omega(stiffness: float, penetration: float, mass: float) -> float:
+    """Contact frequency ω = sqrt(k_t / m) [rad/s] of the Hertz spring at a penetration.
+
+    k_t = 1.5 K sqrt(δ) is the tangent stiffness of K δ^1.5 at δ. Explicit contact stepping
+    is stable for ω h < 2 (MUJOCO_NOTES.md); the run and the retrofit check their time
+    steps against it at the largest expected penetration.
+
+    Args:
+        stiffness: K [N/m^1.5].
+        penetration: δ [m].
+        mass: effective mass along the contact normal [kg].
+    """
+    return math.sqrt(1.5 * stiffness * math.sqrt(penetration) / mass)

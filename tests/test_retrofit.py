@@ -17,11 +17,12 @@ import pytest
 from gym_assets import gym_model
 
 from clearance.cli import main
+from clearance.contact_calibration.laws import contact_omega
 from clearance.model import Material
 from clearance.retrofit import PREFIX, RadialPlay, RetrofitError, RetrofitOptions, retrofit, write_retrofit
 from clearance.retrofit.frames import in_plane_axes
 from clearance.retrofit.motion import fired_warnings
-from clearance.retrofit.sizing import STEP_OMEGA_H, choose_time_step, contact_omega
+from clearance.retrofit.sizing import STEP_OMEGA_H, choose_time_step
 from clearance.retrofit.speed import run_controlled
 
 POLYMER = Material(2.4e9, 0.4)

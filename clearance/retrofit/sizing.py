@@ -31,7 +31,7 @@ import mujoco
 import numpy as np
 
 from clearance.contact_calibration.effective_mass import LIGHT_LOAD
-from clearance.contact_calibration.laws import bearing_stiffness
+from clearance.contact_calibration.laws import bearing_stiffness, contact_omega
 from clearance.mjcf.bearing import choose_segments
 from clearance.model import Clearance
 from clearance.retrofit.coordinates import CoordinateMap
@@ -45,7 +45,6 @@ __all__ = [
     "STEP_OMEGA_H",
     "PlayMass",
     "PlaySizing",
-    "contact_omega",
     "effective_masses",
     "size_play",
     "choose_time_step",
@@ -101,11 +100,6 @@ class PlaySizing:
     penetration_limit: float
     segments: int
     omega: float
-
-
-def contact_omega(stiffness: float, penetration_limit: float, mass: float) -> float:
-    """ω = sqrt(k_t / m) [rad/s], k_t = 1.5 K sqrt(δ_lim): the run's stability rule's frequency."""
-    return math.sqrt(1.5 * stiffness * math.sqrt(penetration_limit) / mass)
 
 
 def _equality_rows(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:

@@ -20,7 +20,7 @@ import mujoco
 import numpy as np
 
 from clearance.contact_calibration.effective_mass import cycle_effective_mass
-from clearance.contact_calibration.laws import bearing_stiffness
+from clearance.contact_calibration.laws import bearing_stiffness, contact_omega
 from clearance.contact_plugin import PLUGIN_NAME, is_available
 from clearance.contact_plugin import require as require_plugin
 from clearance.contact_plugin.attributes import add_for_clearance
@@ -256,7 +256,7 @@ def _contact_for(joint: Joint, built: BuiltModel, sizing: JointSizing, options: 
 def _check_time_step(name: str, s: JointSizing, h: float) -> None:
     """Explicit contact stability needs omega h < 2, omega = sqrt(k_t / m_eff) (MUJOCO_NOTES.md)."""
     k_t = 1.5 * s.stiffness * math.sqrt(s.penetration_limit)
-    omega = math.sqrt(k_t / s.effective_mass)
+    omega = contact_omega(s.stiffness, s.penetration_limit, s.effective_mass)
     if omega * h >= 2.0:
         h_max = 2.0 / omega
         raise TimeStepError(
