@@ -7,6 +7,11 @@ unmodified model, saved with the same asset-path fixes) and DIR/retrofit.md (eve
 the sizing, the calibration, the time step and the speed cost). The options below set every
 hinge's play; a hinge's own values follow its name, with units in the keys:
 ``--joint elbow:clearance_mm=0.2,bearing_radius_mm=8,youngs_modulus_gpa=2.4``.
+
+``--joint elbow:backlash_arcmin=5`` gives an actuated hinge gear backlash instead: a motor side
+that takes its actuators, the hinge (the link) turning within +-5' of it, the stop at MuJoCo's
+default limit (`clearance.retrofit.backlash`); every --joint then names backlash, and the
+play, numerics and sizing options do not apply.
 """
 
 from __future__ import annotations
@@ -24,7 +29,9 @@ from clearance.model import ContactLaw, Material
 from clearance.units import UNITS
 
 if TYPE_CHECKING:
-    from clearance.retrofit import RadialPlay
+    import mujoco
+
+    from clearance.retrofit import Backlash, RadialPlay
 
 __all__ = ["add_parser", "command", "JOINT_KEYS"]
 
@@ -37,9 +44,11 @@ JOINT_KEYS = {
     "friction": "--friction",
     "eccentricity_x_mm": "",
     "eccentricity_y_mm": "",
+    "backlash_arcmin": "",
 }
 """Per-joint keys of ``--joint NAME:key=value,...`` -> the option they override ('': none; the
-journal's start in its bearing frame, [mm], defaults to the centre)."""
+journal's start in its bearing frame, [mm], defaults to the centre; ``backlash_arcmin`` gives
+the hinge gear backlash of that half-width instead of radial play)."""
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -226,6 +235,80 @@ def plays_from_args(args: argparse.Namespace) -> dict[str, RadialPlay]:
     return plays
 
 
+def backlash_from_args(args: argparse.Namespace) -> dict[str, Backlash]:
+    """Hinge name -> `Backlash` where the --joint options name ``backlash_arcmin``; {} where none does.
+
+    Raises:
+        ValueError: some --joint name backlash and others not, a backlash joint with radial
+            play keys too, a half-width outside (0, 600] arc-minutes (10 degrees), a joint named twice.
+    """
+    from clearance.retrofit import MAX_BACKLASH, Backlash
+
+    cap = math.degrees(MAX_BACKLASH) * 60
+    given = [
+        (text, {item.partition("=")[0].strip() for item in text.partition(":")[2].split(",")}) for text in args.joint
+    ]
+    with_backlash = [(text, keys) for text, keys in given if "backlash_arcmin" in keys]
+    if not with_backlash:
+        return {}
+    if len(with_backlash) != len(args.joint):
+        other = next(text for text, keys in given if "backlash_arcmin" not in keys)
+        raise ValueError(
+            f"--joint {other!r}: backlash and radial play cannot be mixed in one command yet "
+            f"(--joint {with_backlash[0][0]!r} names backlash_arcmin)"
+        )
+    out: dict[str, Backlash] = {}
+    for text, keys in with_backlash:
+        name, v = _joint_values(args, text)
+        extra = sorted(keys - {"backlash_arcmin"})
+        if extra:
+            raise ValueError(
+                f"--joint {text!r}: a hinge with backlash takes no radial play keys (got {', '.join(extra)}); "
+                "backlash and radial play at one hinge are refused"
+            )
+        if name in out:
+            raise ValueError(f"--joint: hinge '{name}' is named twice")
+        b = v["backlash_arcmin"]
+        if not 0 < b <= cap:
+            raise ValueError(f"--joint {text!r}: backlash_arcmin must be in (0, {cap:g}] (got {b:g})")
+        out[name] = Backlash.from_arcmin(b)
+    return out
+
+
+def _backlash_command(args: argparse.Namespace, joints: dict[str, Backlash]) -> int:
+    """``clearance retrofit`` with backlash at every named hinge; returns the exit status."""
+    from clearance.retrofit import add_backlash
+    from clearance.retrofit.output import write_backlash
+
+    out = check_folder(args.out, "--out")
+    spec = _read_model(Path(args.model))
+    with folder_lock(out):
+        try:
+            result = add_backlash(spec, joints)
+        except ValueError as err:
+            raise ValueError(f"{args.model}: {err}") from None
+        line = ["clearance retrofit", args.model, *[f"--joint {j}" for j in args.joint], f"--out {args.out}"]
+        paths = write_backlash(
+            result, out, source_dir=Path(args.model).resolve().parent, source=str(args.model), command=" ".join(line)
+        )
+    for note in result.notes:
+        print(note)
+    print("wrote " + ", ".join(str(p) for p in paths.values()))
+    return 0
+
+
+def _read_model(path: Path) -> mujoco.MjSpec:
+    """The model file's spec; a missing or unreadable file is refused naming it."""
+    import mujoco
+
+    if not path.is_file():
+        raise ValueError(f"model file {path} does not exist" if not path.exists() else f"{path} is not a file")
+    try:
+        return mujoco.MjSpec.from_file(str(path))
+    except ValueError as err:
+        raise ValueError(f"model file {path} cannot be read by MuJoCo: {err}") from None
+
+
 def _command_line(args: argparse.Namespace) -> str:
     parts = ["clearance retrofit", args.model, *[f"--joint {j}" for j in args.joint], f"--out {args.out}"]
     for flag in (
@@ -256,10 +339,12 @@ def _command_line(args: argparse.Namespace) -> str:
 
 def command(args: argparse.Namespace) -> int:
     """Run ``clearance retrofit``; returns the exit status (2: refused)."""
-    import mujoco
 
     from clearance.retrofit import RetrofitOptions, SineControl, retrofit, write_retrofit
 
+    backlash = backlash_from_args(args)
+    if backlash:
+        return _backlash_command(args, backlash)
     plays = plays_from_args(args)
     options = RetrofitOptions(
         contact_mode=args.contact_mode,
@@ -273,12 +358,7 @@ def command(args: argparse.Namespace) -> int:
     )
     out = check_folder(args.out, "--out")
     path = Path(args.model)
-    if not path.is_file():
-        raise ValueError(f"model file {path} does not exist" if not path.exists() else f"{path} is not a file")
-    try:
-        spec = mujoco.MjSpec.from_file(str(path))
-    except ValueError as err:
-        raise ValueError(f"model file {path} cannot be read by MuJoCo: {err}") from None
+    spec = _read_model(path)
     check_steps(args.sizing_duration_s, spec.option.timestep, f"--sizing-duration-s {args.sizing_duration_s:g}")
     if args.sizing_control is not None:
         from clearance.retrofit.drive import actuator_labels, read_control_file

@@ -5,7 +5,9 @@
 a ring bearing and the child body a journal, with the ring's soft contact calibrated at the
 bearing's own effective mass and impact speeds (the mechanisms' bearing, calibration and
 contact code, unchanged). `write_retrofit` writes the model, its unmodified twin and a report
-of every change. Planar play only: the journal cannot tilt in its bearing.
+of every change. Planar play only: the journal cannot tilt in its bearing. `add_backlash`
+gives actuated hinges angular play instead (gear backlash: a motor side, a load side and a
+dead band, `clearance.retrofit.backlash`).
 
 The request's records (`RadialPlay`, `RetrofitOptions`, ...) import no MuJoCo; `retrofit`,
 `Retrofit`, `RetrofittedHinge` and `write_retrofit` are imported on first use.
@@ -19,7 +21,9 @@ from typing import TYPE_CHECKING
 from clearance.retrofit.play import (
     DEFAULT_BEARING_RADIUS,
     DEFAULT_RADIAL_CLEARANCE,
+    MAX_BACKLASH,
     PREFIX,
+    Backlash,
     ControlTable,
     RadialPlay,
     RetrofitError,
@@ -28,13 +32,17 @@ from clearance.retrofit.play import (
 )
 
 if TYPE_CHECKING:
+    from clearance.retrofit.backlash import BacklashRetrofit, add_backlash
     from clearance.retrofit.output import write_retrofit
     from clearance.retrofit.pipeline import Retrofit, RetrofittedHinge, retrofit
 
 __all__ = [
+    "Backlash",
+    "BacklashRetrofit",
     "ControlTable",
     "DEFAULT_BEARING_RADIUS",
     "DEFAULT_RADIAL_CLEARANCE",
+    "MAX_BACKLASH",
     "PREFIX",
     "RadialPlay",
     "Retrofit",
@@ -42,11 +50,14 @@ __all__ = [
     "RetrofitOptions",
     "RetrofittedHinge",
     "SineControl",
+    "add_backlash",
     "retrofit",
     "write_retrofit",
 ]
 
 _LAZY = {
+    "add_backlash": "backlash",
+    "BacklashRetrofit": "backlash",
     "retrofit": "pipeline",
     "Retrofit": "pipeline",
     "RetrofittedHinge": "pipeline",

@@ -10,6 +10,7 @@ reported as done.
 
 from __future__ import annotations
 
+import math
 import os
 from pathlib import Path
 
@@ -17,11 +18,12 @@ import mujoco
 
 from clearance.results import atomic_write_text
 from clearance.retrofit.assets import relocate_assets
+from clearance.retrofit.backlash import MOTOR_MASS, BacklashRetrofit
 from clearance.retrofit.manifest import MANIFEST_FILE, HingeRecord, RetrofitManifest
 from clearance.retrofit.pipeline import Retrofit
 from clearance.retrofit.report import retrofit_report
 
-__all__ = ["MODEL_FILE", "TWIN_FILE", "REPORT_FILE", "manifest_of", "write_retrofit"]
+__all__ = ["MODEL_FILE", "TWIN_FILE", "REPORT_FILE", "manifest_of", "write_backlash", "write_retrofit"]
 
 MODEL_FILE = "model.xml"
 TWIN_FILE = "original.xml"
@@ -74,6 +76,62 @@ def write_retrofit(
         raise RuntimeError(f"the written model {paths['model']} does not compile: {err}") from None
     atomic_write_text(paths["manifest"], manifest_of(result).to_json())
     atomic_write_text(paths["report"], retrofit_report(result, source=source, command=command, asset_changes=changes))
+    return paths
+
+
+def write_backlash(
+    result: BacklashRetrofit,
+    out_dir: str | os.PathLike[str],
+    *,
+    source_dir: str | os.PathLike[str] | None = None,
+    source: str = "",
+    command: str = "",
+) -> dict[str, Path]:
+    """Write ``model.xml``, ``original.xml`` and ``retrofit.md`` of a backlash edit into ``out_dir``.
+
+    No ``retrofit.json``: ``clearance run --model`` reads radial play only. Arguments as
+    `write_retrofit`'s; returns file role ('model', 'original', 'report') -> path.
+
+    Raises:
+        RuntimeError: the written model does not compile from its file.
+    """
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    src = Path(source_dir if source_dir is not None else (result.twin_spec.modelfiledir or "."))
+    paths = {"model": out / MODEL_FILE, "original": out / TWIN_FILE, "report": out / REPORT_FILE}
+    changes: list[str] = []
+    for role, spec in (("model", result.spec), ("original", result.twin_spec)):
+        copy = spec.copy()
+        found = relocate_assets(copy, src, out)
+        if role == "model":
+            changes = found
+        atomic_write_text(paths[role], copy.to_xml())
+    try:
+        mujoco.MjModel.from_xml_path(str(paths["model"]))
+    except ValueError as err:
+        raise RuntimeError(f"the written model {paths['model']} does not compile: {err}") from None
+    lines = ["# Backlash retrofit", ""]
+    if source:
+        lines.append(f"Model: `{source}`" + (f"; command: `{command}`" if command else ""))
+        lines.append("")
+    lines += [
+        "Each hinge keeps its name, body, sensors, limits and keyframe values (the load side, the link). A motor "
+        "body beside it on the same axis takes its actuators, its armature and its damping; the load may turn within "
+        "+-b of the motor, by the limit of a fixed tendon q_load - q_motor at MuJoCo's default stop (not "
+        "calibrated). Keyframes start each band centred.",
+        "",
+        "| hinge | b [arcmin] | motor hinge | motor body | dead-band tendon | actuators moved | motor armature "
+        "[kg m^2] |",
+        "|---|---|---|---|---|---|---|",
+    ]
+    for h in result.hinges.values():
+        lines.append(
+            f"| {h.name} | {math.degrees(h.backlash.half_width) * 60:.4g} | {h.motor_joint} | {h.motor_body} | "
+            f"{h.tendon} | {', '.join(h.actuators)} | {h.motor_armature:.4g} ({h.armature_source}) |"
+        )
+    lines += ["", f"Keyframes extended: {result.keyframes}. Each motor body's mass: {MOTOR_MASS:g} kg."]
+    lines += [f"- asset path: {c}" for c in changes]
+    atomic_write_text(paths["report"], "\n".join(lines) + "\n")
     return paths
 
 

@@ -19,6 +19,8 @@ from clearance.model import STEEL, Clearance, ContactLaw, Material
 from clearance.options import ContactMode, GeomType
 
 __all__ = [
+    "Backlash",
+    "MAX_BACKLASH",
     "DEFAULT_BEARING_RADIUS",
     "DEFAULT_CLASS",
     "DEFAULT_RADIAL_CLEARANCE",
@@ -111,6 +113,45 @@ class RadialPlay:
             law=law,
         )
         return cls(c, initial_eccentricity)
+
+
+MAX_BACKLASH = math.radians(10.0)
+"""Largest backlash half-width a hinge accepts [rad] (10 degrees): beyond it the dead band is
+a loose coupling rather than gear play."""
+
+
+@dataclass(frozen=True)
+class Backlash:
+    """Angular play (gear backlash) of one actuated hinge: a dead band of +-b between motor and link.
+
+    The hinge keeps its name and its body (the link, the load side); a motor side on the same
+    axis takes the model's actuators, and the load may turn within +-b of the motor
+    (`clearance.retrofit.backlash`).
+
+    Attributes:
+        half_width: b [rad], in (0, `MAX_BACKLASH`].
+        motor_armature: the motor side's inertia about the axis [kg m^2] (the rotor's reflected
+            inertia); None: the hinge's own ``armature`` moves to the motor side, or where the
+            hinge has none, `clearance.retrofit.backlash.MOTOR_ARMATURE_FRACTION` of the
+            hinge's inertia at the model's reference pose.
+    """
+
+    half_width: float
+    motor_armature: float | None = None
+
+    def __post_init__(self) -> None:
+        b = finite("backlash half_width", self.half_width)
+        if not 0 < b <= MAX_BACKLASH:
+            raise RetrofitError(
+                f"backlash half_width must be in (0, {MAX_BACKLASH:.6g}] rad (10 degrees) (got {self.half_width!r})"
+            )
+        if self.motor_armature is not None:
+            positive("motor_armature", self.motor_armature, "kg m^2")
+
+    @classmethod
+    def from_arcmin(cls, half_width_arcmin: float, motor_armature: float | None = None) -> Backlash:
+        """A backlash from its half-width in arc-minutes."""
+        return cls(math.radians(finite("backlash_arcmin", half_width_arcmin) / 60.0), motor_armature)
 
 
 @dataclass(frozen=True)

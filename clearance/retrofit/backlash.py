@@ -1,0 +1,308 @@
+"""Backlash at actuated hinges: a motor side and a load side with a dead band of +-b.
+
+The hinge keeps its name, its body and its meaning (the link's angle relative to its
+parent), so its sensors, limits, damping and keyframe values are untouched: the load side.
+A motor body ``clr_<hinge>__motor`` is added beside the link (a child of the link's parent,
+at the link's frame) with a hinge ``<hinge>__motor`` on the same axis; the model's actuators
+on the hinge are moved to it. The dead band is a fixed tendon
+``clr_<hinge>__backlash`` = q_load - q_motor, limited to [-b, b]: the two coincident hinges
+and a limit of MuJoCo's recipe, with the limit on their difference so neither angle changes
+meaning. The stop is the tendon limit's constraint at MuJoCo's defaults (not calibrated).
+
+The motor body carries no mass (`MOTOR_MASS`, MuJoCo's floor requires some); the motor's
+inertia is its hinge's armature: the hinge's own armature moved to the motor side (the
+rotor's reflected inertia is what a joint armature models), or `MOTOR_ARMATURE_FRACTION` of
+the hinge's inertia at the reference pose where it has none, or the value the user gives.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import mujoco
+import numpy as np
+
+from clearance.retrofit.elements import add_builtin_class
+from clearance.retrofit.play import PREFIX, Backlash, RetrofitError
+from clearance.retrofit.selection import compile_model, model_label
+
+__all__ = [
+    "MOTOR_ARMATURE_FRACTION",
+    "MOTOR_MASS",
+    "BacklashHinge",
+    "BacklashRetrofit",
+    "add_backlash",
+    "motor_joint_name",
+]
+
+MOTOR_MASS = 1e-12
+"""Mass and each principal inertia of a motor body [kg, kg m^2]: none to speak of (MuJoCo
+refuses a moving body without mass); the motor's inertia is its hinge's armature."""
+
+MOTOR_ARMATURE_FRACTION = 0.01
+"""Motor armature, where the hinge has none and none is given, as a fraction of the hinge's
+diagonal mass-matrix entry at the model's reference pose [-]."""
+
+_HINGE = mujoco.mjtJoint.mjJNT_HINGE
+_TRN_JOINT = (int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT))
+_QPOS_WIDTH = {
+    mujoco.mjtJoint.mjJNT_FREE: 7,
+    mujoco.mjtJoint.mjJNT_BALL: 4,
+    mujoco.mjtJoint.mjJNT_SLIDE: 1,
+    mujoco.mjtJoint.mjJNT_HINGE: 1,
+}
+_DOF_WIDTH = {
+    mujoco.mjtJoint.mjJNT_FREE: 6,
+    mujoco.mjtJoint.mjJNT_BALL: 3,
+    mujoco.mjtJoint.mjJNT_SLIDE: 1,
+    mujoco.mjtJoint.mjJNT_HINGE: 1,
+}
+
+
+def motor_joint_name(hinge: str) -> str:
+    """The motor side's hinge of ``hinge``."""
+    return f"{hinge}__motor"
+
+
+@dataclass(frozen=True)
+class BacklashHinge:
+    """One hinge given backlash.
+
+    Attributes:
+        name: the hinge (the load side, name kept).
+        backlash: what was asked.
+        motor_joint: the motor side's hinge.
+        motor_body: the motor body.
+        tendon: the dead band's tendon (q_load - q_motor, limited to +-b).
+        actuators: names (or ``#k``) of the actuators moved to the motor side.
+        motor_armature: the motor hinge's armature [kg m^2].
+        armature_source: where it came from ('the hinge's armature (moved)', 'given', or the
+            fraction of the hinge's inertia).
+    """
+
+    name: str
+    backlash: Backlash
+    motor_joint: str
+    motor_body: str
+    tendon: str
+    actuators: tuple[str, ...]
+    motor_armature: float
+    armature_source: str
+
+
+@dataclass
+class BacklashRetrofit:
+    """A model with backlash at hinges, its unmodified twin, and what changed.
+
+    Attributes:
+        spec: the edited spec. model: it compiled.
+        twin_spec: the unmodified spec (a copy). twin: it compiled.
+        hinges: hinge name -> what was added for it, in the order given.
+        keyframes: keyframes extended (each motor angle and speed = its load's: the band centred).
+        notes: remarks for a report.
+    """
+
+    spec: mujoco.MjSpec
+    model: mujoco.MjModel
+    twin_spec: mujoco.MjSpec
+    twin: mujoco.MjModel
+    hinges: dict[str, BacklashHinge]
+    keyframes: int
+    notes: list[str] = field(default_factory=list)
+
+
+def _actuator_label(model: mujoco.MjModel, k: int) -> str:
+    return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_ACTUATOR, k) or f"#{k}"
+
+
+def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> dict[str, list[int]]:
+    """Hinge name -> ids of the actuators on it; raises `RetrofitError` for a hinge that cannot take backlash."""
+    where = model_label(spec)
+    actuated: dict[str, list[int]] = {}
+    for name, play in joints.items():
+        if not isinstance(play, Backlash):
+            raise RetrofitError(f"the backlash of hinge '{name}' must be a Backlash (got {play!r})")
+        j = mujoco.mj_name2id(twin, mujoco.mjtObj.mjOBJ_JOINT, name) if isinstance(name, str) and name else -1
+        if j < 0:
+            raise RetrofitError(f"hinge '{name}': no joint of that name in {where}")
+        if int(twin.jnt_type[j]) != int(_HINGE):
+            raise RetrofitError(f"hinge '{name}': backlash needs a hinge, got a joint of type {twin.jnt_type[j]}")
+        body = int(twin.jnt_bodyid[j])
+        if twin.body_jntnum[body] != 1:
+            raise RetrofitError(
+                f"hinge '{name}': its body has {twin.body_jntnum[body]} joints; backlash needs it alone"
+            )
+        for clash in (motor_joint_name(name), f"{PREFIX}{name}__motor", f"{PREFIX}{name}__backlash"):
+            for obj in (mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_TENDON):
+                if mujoco.mj_name2id(twin, obj, clash) >= 0:
+                    raise RetrofitError(f"hinge '{name}': {where} already has an element named '{clash}'")
+        on_joint = [
+            k for k in range(twin.nu) if int(twin.actuator_trntype[k]) in _TRN_JOINT and twin.actuator_trnid[k, 0] == j
+        ]
+        dof = int(twin.jnt_dofadr[j])
+        for k in range(twin.nu):
+            if k in on_joint or int(twin.actuator_trntype[k]) != int(mujoco.mjtTrn.mjTRN_TENDON):
+                continue
+            t = int(twin.actuator_trnid[k, 0])
+            adr, num = int(twin.tendon_adr[t]), int(twin.tendon_num[t])
+            if any(
+                int(twin.wrap_type[adr + i]) == int(mujoco.mjtWrap.mjWRAP_JOINT) and twin.wrap_objid[adr + i] == j
+                for i in range(num)
+            ):
+                raise RetrofitError(
+                    f"hinge '{name}': actuator '{_actuator_label(twin, k)}' drives it through a tendon; backlash moves "
+                    "only actuators with joint= to the motor side"
+                )
+        if not on_joint:
+            raise RetrofitError(
+                f"hinge '{name}' (dof {dof}) has no actuator with joint= on it: backlash sits between a motor and its "
+                "link, and an unactuated hinge has no motor side"
+            )
+        actuated[name] = on_joint
+    return actuated
+
+
+def _reference_inertia(twin: mujoco.MjModel, dof: int) -> float:
+    """The hinge's diagonal mass-matrix entry at the reference pose [kg m^2]."""
+    data = mujoco.MjData(twin)
+    mujoco.mj_forward(twin, data)
+    full = np.zeros((twin.nv, twin.nv))
+    mujoco.mj_fullM(twin, data, full)
+    return float(full[dof, dof])
+
+
+def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> BacklashRetrofit:
+    """Give each named actuated hinge of ``spec`` backlash: a motor side, a load side, a dead band of +-b.
+
+    Args:
+        spec: the user's model (not changed: the edit is on a copy).
+        joints: hinge name -> its backlash.
+
+    Returns:
+        The edited model, its twin and what was added.
+
+    Raises:
+        RetrofitError: before any work, for a joint that does not exist, is not a hinge, shares
+            its body with another joint, has no actuator with ``joint=`` on it, or is driven
+            through a tendon; a model that does not compile.
+    """
+    twin_spec = spec.copy()
+    twin = compile_model(twin_spec)
+    actuated = _check(twin, twin_spec, joints)
+
+    work = spec.copy()
+    compile_model(work)  # the work spec's elements get the twin's ids
+    old_joints = list(work.joints)
+    bodies = {int(b.id): b for b in work.bodies}
+    old_bodies = sorted(bodies)
+    actuators = {int(a.id): a for a in work.actuators}
+    cls = add_builtin_class(work)
+    done: dict[str, BacklashHinge] = {}
+    for name, play in joints.items():
+        j = mujoco.mj_name2id(twin, mujoco.mjtObj.mjOBJ_JOINT, name)
+        body = int(twin.jnt_bodyid[j])
+        hinge = work.joint(name)
+        dof = int(twin.jnt_dofadr[j])
+        own, damping = float(twin.dof_armature[dof]), np.array(hinge.damping, dtype=float)
+        hinge.armature, hinge.damping = 0.0, np.zeros_like(damping)
+        if play.motor_armature is not None:
+            armature, source = play.motor_armature, "given"
+        elif own > 0:
+            armature, source = own, "the hinge's armature (moved)"
+        else:
+            armature = MOTOR_ARMATURE_FRACTION * _reference_inertia(twin, dof)
+            source = f"{MOTOR_ARMATURE_FRACTION:g} x the hinge's inertia at the reference pose"
+        motor_body = f"{PREFIX}{name}__motor"
+        motor = bodies[int(twin.body_parentid[body])].add_body(
+            name=motor_body,
+            pos=twin.body_pos[body],
+            quat=twin.body_quat[body],
+            mass=MOTOR_MASS,
+            inertia=[MOTOR_MASS] * 3,
+            explicitinertial=True,
+            ipos=[0.0, 0.0, 0.0],
+            iquat=[1.0, 0.0, 0.0, 0.0],  # set, so the MJCF writer writes the inertial
+        )
+        motor.add_joint(
+            cls,
+            name=motor_joint_name(name),
+            type=_HINGE,
+            pos=twin.jnt_pos[j],
+            axis=twin.jnt_axis[j],
+            armature=armature,
+            damping=damping,
+        )
+        tendon = f"{PREFIX}{name}__backlash"
+        band = work.add_tendon(
+            name=tendon, limited=mujoco.mjtLimited.mjLIMITED_TRUE, range=[-play.half_width, play.half_width]
+        )
+        band.wrap_joint(name, 1.0)
+        band.wrap_joint(motor_joint_name(name), -1.0)
+        for k in actuated[name]:
+            actuators[k].target = motor_joint_name(name)
+        done[name] = BacklashHinge(
+            name,
+            play,
+            motor_joint_name(name),
+            motor_body,
+            tendon,
+            tuple(_actuator_label(twin, k) for k in actuated[name]),
+            armature,
+            source,
+        )
+    kinematic = compile_model(work)
+    nkeys = _extend_keyframes(work, twin, kinematic, old_joints, done)
+    model = compile_model(work)
+    kept = np.array([int(bodies[b].id) for b in old_bodies])
+    if not np.array_equal(model.body_mass[kept], twin.body_mass) or not np.array_equal(
+        model.body_inertia[kept], twin.body_inertia
+    ):
+        raise RuntimeError("backlash changed a body's mass or inertia")
+    notes = [
+        f"hinge '{h.name}': actuators {', '.join(h.actuators)} moved to '{h.motor_joint}' (armature "
+        f"{h.motor_armature:.4g} kg m^2, {h.armature_source}); dead band +-{h.backlash.half_width:.4g} rad by the "
+        f"limit of tendon '{h.tendon}' at MuJoCo's default stop (not calibrated); sensors stay on the load side"
+        for h in done.values()
+    ]
+    return BacklashRetrofit(work, model, twin_spec, twin, done, nkeys, notes)
+
+
+def _extend_keyframes(
+    work: mujoco.MjSpec,
+    twin: mujoco.MjModel,
+    model: mujoco.MjModel,
+    old_joints: list[mujoco.MjsJoint],
+    done: Mapping[str, BacklashHinge],
+) -> int:
+    """Rewrite each keyframe's qpos and qvel for ``model``: the twin's values where its joints now
+    sit, each motor angle and speed equal to its load's (the band centred). Returns the count."""
+    qmap: list[tuple[int, int, int]] = []  # (twin adr, model adr, width) for qpos
+    vmap: list[tuple[int, int, int]] = []
+    for jt, spec_joint in enumerate(old_joints):
+        jm = int(spec_joint.id)
+        kind = mujoco.mjtJoint(int(twin.jnt_type[jt]))
+        qmap.append((int(twin.jnt_qposadr[jt]), int(model.jnt_qposadr[jm]), _QPOS_WIDTH[kind]))
+        vmap.append((int(twin.jnt_dofadr[jt]), int(model.jnt_dofadr[jm]), _DOF_WIDTH[kind]))
+    motors = [
+        (int(model.jnt_qposadr[model.joint(h.name).id]), int(model.jnt_qposadr[model.joint(h.motor_joint).id]))
+        for h in done.values()
+    ]
+    dmotors = [
+        (int(model.jnt_dofadr[model.joint(h.name).id]), int(model.jnt_dofadr[model.joint(h.motor_joint).id]))
+        for h in done.values()
+    ]
+    for k, key in enumerate(work.keys):
+        qpos = model.qpos0.copy()
+        qvel = np.zeros(model.nv)
+        for a, b, n in qmap:
+            qpos[b : b + n] = twin.key_qpos[k, a : a + n]
+        for a, b, n in vmap:
+            qvel[b : b + n] = twin.key_qvel[k, a : a + n]
+        for load, motor in motors:
+            qpos[motor] = qpos[load]
+        for load, motor in dmotors:
+            qvel[motor] = qvel[load]
+        key.qpos = qpos
+        key.qvel = qvel
+    return len(work.keys)
