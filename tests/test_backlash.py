@@ -180,3 +180,40 @@ def test_cli_refuses_bad_backlash_before_any_work(tmp_path, capsys, joints, expe
     assert code == 2
     assert expected in err and err.count("\n") == 1 and "Traceback" not in err
     assert not out.exists()
+
+
+NESTED = """<mujoco><worldbody>
+<body name="base"><joint name="yaw" type="hinge" axis="0 0 1"/><geom type="sphere" size="0.1"/>
+<body name="arm" pos="0.2 0 0"><joint name="pitch" type="hinge" axis="0 1 0"/><geom type="sphere" size="0.05"/></body>
+</body>
+<body name="other" pos="1 0 0"><joint name="roll" type="hinge" axis="1 0 0"/><geom type="sphere" size="0.05"/></body>
+</worldbody>
+<tendon><fixed name="coupler"><joint joint="roll" coef="1"/></fixed></tendon>
+<actuator><motor joint="pitch"/><motor tendon="coupler"/></actuator>
+<keyframe><key qpos="0.1 0.2 0.3" qvel="1 2 3"/></keyframe></mujoco>"""
+
+
+def test_keyframes_follow_joints_whose_coordinates_moved():
+    """The motor body of 'pitch' is a child of 'base', so 'roll' comes after it in the coordinates."""
+    out = add_backlash(mujoco.MjSpec.from_string(NESTED), {"pitch": Backlash(B)})
+    m = out.model
+    assert m.joint("roll").qposadr[0] == 3  # moved from 2: the case the mapping exists for
+    q, v = m.key_qpos[0], m.key_qvel[0]
+    for name, angle, speed in (("yaw", 0.1, 1), ("pitch", 0.2, 2), ("roll", 0.3, 3), ("pitch__motor", 0.2, 2)):
+        assert q[m.joint(name).qposadr[0]] == angle and v[m.joint(name).dofadr[0]] == speed
+
+
+@pytest.mark.parametrize(
+    ("xml", "joint", "expected"),
+    [
+        (NESTED, "roll", "drives it through a tendon"),
+        (
+            NESTED.replace('<joint name="pitch"', '<joint name="pitch2" type="slide"/><joint name="pitch"'),
+            "pitch",
+            "its body has 2 joints",
+        ),
+    ],
+)
+def test_tendon_drives_and_shared_bodies_are_refused(xml, joint, expected):
+    with pytest.raises(RetrofitError, match=expected):
+        add_backlash(mujoco.MjSpec.from_string(xml), {joint: Backlash(B)})
