@@ -63,9 +63,23 @@ def write_retrofit(
         "report": out / REPORT_FILE,
         "manifest": out / MANIFEST_FILE,
     }
+    changes = _write_models(result.spec, result.twin_spec, src, out, paths)
+    atomic_write_text(paths["manifest"], manifest_of(result).to_json())
+    atomic_write_text(paths["report"], retrofit_report(result, source=source, command=command, asset_changes=changes))
+    return paths
+
+
+def _write_models(
+    spec: mujoco.MjSpec, twin_spec: mujoco.MjSpec, src: Path, out: Path, paths: dict[str, Path]
+) -> list[str]:
+    """Write the edited model and its twin (asset folders rewritten for ``out``); the model's asset changes.
+
+    Raises:
+        RuntimeError: the written model does not compile from its file.
+    """
     changes: list[str] = []
-    for role, spec in (("model", result.spec), ("original", result.twin_spec)):
-        copy = spec.copy()
+    for role, s in (("model", spec), ("original", twin_spec)):
+        copy = s.copy()
         found = relocate_assets(copy, src, out)
         if role == "model":
             changes = found
@@ -74,9 +88,7 @@ def write_retrofit(
         mujoco.MjModel.from_xml_path(str(paths["model"]))
     except ValueError as err:
         raise RuntimeError(f"the written model {paths['model']} does not compile: {err}") from None
-    atomic_write_text(paths["manifest"], manifest_of(result).to_json())
-    atomic_write_text(paths["report"], retrofit_report(result, source=source, command=command, asset_changes=changes))
-    return paths
+    return changes
 
 
 def write_backlash(
@@ -99,17 +111,7 @@ def write_backlash(
     out.mkdir(parents=True, exist_ok=True)
     src = Path(source_dir if source_dir is not None else (result.twin_spec.modelfiledir or "."))
     paths = {"model": out / MODEL_FILE, "original": out / TWIN_FILE, "report": out / REPORT_FILE}
-    changes: list[str] = []
-    for role, spec in (("model", result.spec), ("original", result.twin_spec)):
-        copy = spec.copy()
-        found = relocate_assets(copy, src, out)
-        if role == "model":
-            changes = found
-        atomic_write_text(paths[role], copy.to_xml())
-    try:
-        mujoco.MjModel.from_xml_path(str(paths["model"]))
-    except ValueError as err:
-        raise RuntimeError(f"the written model {paths['model']} does not compile: {err}") from None
+    changes = _write_models(result.spec, result.twin_spec, src, out, paths)
     lines = ["# Backlash retrofit", ""]
     if source:
         lines.append(f"Model: `{source}`" + (f"; command: `{command}`" if command else ""))
