@@ -27,7 +27,8 @@ from clearance.analysis.metrics.response import window_peaks
 from clearance.analysis.metrics.statistics import deviation_statistics, drive_period
 from clearance.results import ENERGY_TERMS, SimulationResult, atomic_write_text
 
-if TYPE_CHECKING:  # the sweeps' modules load only where a diagram or ranking is drawn
+if TYPE_CHECKING:  # types only: the sweeps' modules load only where a diagram or ranking is drawn
+    from clearance.analysis.metrics.reactions import ReactionSummary
     from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
     from clearance.analysis.sweeps.criticality import CriticalityRanking
 
@@ -138,7 +139,13 @@ def lag_lines(lag: OutputLag) -> list[str]:
     ]
 
 
-def reactions_section(result: SimulationResult, ideal: SimulationResult, window: Window, out: Path) -> list[str]:
+def reactions_section(
+    result: SimulationResult,
+    ideal: SimulationResult,
+    window: Window,
+    out: Path,
+    rows: list[ReactionSummary] | None = None,
+) -> list[str]:
     """The report's "Joint reactions" section (the bearing load at every joint) and its figure.
 
     Draws ``joint_reactions.png`` (`plot_reactions`) and returns the section of
@@ -149,6 +156,7 @@ def reactions_section(result: SimulationResult, ideal: SimulationResult, window:
         ideal: its ideal twin's run.
         window: its start-up window.
         out: the report's folder.
+        rows: the summaries when already computed (`summarise_reactions` with the same window).
 
     Returns:
         The section's Markdown lines.
@@ -156,7 +164,8 @@ def reactions_section(result: SimulationResult, ideal: SimulationResult, window:
     from clearance.analysis.figures.reaction_figures import plot_reactions, reaction_section
     from clearance.analysis.metrics.reactions import summarise_reactions
 
-    rows = summarise_reactions(result, ideal, startup=window.startup)
+    if rows is None:
+        rows = summarise_reactions(result, ideal, startup=window.startup)
     draw(plot_reactions, result, ideal, startup=window.startup, path=out / "joint_reactions.png")
     return reaction_section(result, ideal, startup=window.startup, figure="joint_reactions.png", rows=rows)
 
@@ -239,6 +248,7 @@ def write_report(
     bifurcation: BifurcationDiagram | None = None,
     ranking: CriticalityRanking | None = None,
     processes: int = 1,
+    reactions: list[ReactionSummary] | None = None,
 ) -> Path:
     """Analyse a run against its ideal twin and write ``<out_dir>/report.md`` with figures.
 
@@ -255,6 +265,8 @@ def write_report(
         ranking: a criticality ranking to include.
         processes: 2 draws the figures in this process and a forked child at once
             (`clearance.analysis.figures.drawing`); 1 draws them here, one after the other.
+        reactions: the joint-reaction summaries when already computed with the same window
+            (`summarise_reactions`), else computed here.
 
     Returns:
         Path of ``report.md``.
@@ -271,7 +283,7 @@ def write_report(
     period = drive_period(result)
     window = Window(float(result.times[0]), period if skip is None else skip, float(result.times[-1]))
     with figures_in_parallel(processes):
-        lines = _report_lines(out, result, ideal, output, window, period, title, bifurcation, ranking)
+        lines = _report_lines(out, result, ideal, output, window, period, title, bifurcation, ranking, reactions)
     path = out / "report.md"
     atomic_write_text(path, "\n".join(lines))
     return path
@@ -287,6 +299,7 @@ def _report_lines(
     title: str | None,
     bifurcation: BifurcationDiagram | None,
     ranking: CriticalityRanking | None,
+    reactions: list[ReactionSummary] | None = None,
 ) -> list[str]:
     """The report's Markdown lines; its figures are handed to `draw`."""
     md = result.metadata
@@ -340,7 +353,7 @@ def _report_lines(
     if result.joints:
         lines += contact_section(result, window, out)
     if getattr(result, "joint_reactions", None):  # the joint reactions' section, where the result has them
-        lines += reactions_section(result, ideal, window, out)
+        lines += reactions_section(result, ideal, window, out, reactions)
     lines += energy_section(result)
     lines += poincare_section(result, output, window, period, out)
 

@@ -65,7 +65,7 @@ def write_outputs(
     reactions = summarise_reactions(result, ideal, startup=skip)
     write_reactions_csv(reactions, out / "reactions.csv")
     # the figures in two processes where there are two CPUs (each drawn once, the child waited for)
-    write_report(out, result, ideal, skip=skip, processes=2 if (os.cpu_count() or 1) >= 2 else 1)
+    write_report(out, result, ideal, skip=skip, processes=2 if (os.cpu_count() or 1) >= 2 else 1, reactions=reactions)
     output = mech.outputs[0].name
     angular = mech.outputs[0].kind is OutputKind.ANGLE
     for r in rows:
