@@ -36,6 +36,7 @@ FLOORS: dict[str, str] = {
     "clearance.reference": "reference",
     "clearance.run": "run",
     "clearance.analysis": "analysis",
+    "clearance.analysis.design": "analysis",
     "clearance.bench": "bench",
     "clearance.cli": "command line",
 }

@@ -1,0 +1,1 @@
+"""Design for clearance: start-state ensembles, tolerance allocation, design optimisation."""
