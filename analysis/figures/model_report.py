@@ -12,7 +12,9 @@ from __future__ import annotations
 from pathlib import Path
 
 from clearance.analysis.figures.analysis_figures import plot_deviation
+from clearance.analysis.figures.backlash_figures import backlash_section
 from clearance.analysis.figures.plots import plot_contact_force, plot_orbit
+from clearance.analysis.metrics.backlash_impacts import backlash_summaries
 from clearance.analysis.metrics.response import contact_modes
 from clearance.analysis.metrics.site_deviation import SiteDeviation
 from clearance.analysis.metrics.summary import JointSummary
@@ -56,26 +58,30 @@ def write_model_report(
         f"- model: `{meta.get('mechanism', '')}`, its unmodified twin run beside it at the same step and controls",
         f"- drive: {meta.get('drive', '')}",
         f"- simulated {result.times[-1] - result.times[0] + h:.4g} s at h = {h:g} s (the model's own step "
-        f"{meta.get('original_timestep', float('nan')):g} s); {meta.get('contact_mode', '')} ring bearings",
+        f"{meta.get('original_timestep', float('nan')):g} s); "
+        + (f"{meta.get('contact_mode', '')} ring bearings" if result.joints else "no radial play"),
         f"- {meta.get('steps_per_second', 0) or 0:.3g} steps/s "
         f"(twin {twin.metadata.get('steps_per_second', 0) or 0:.3g})",
-        "- planar play only: each journal moves in the plane normal to its hinge axis, it cannot tilt",
     ]
+    if result.joints:
+        lines.append("- planar play only: each journal moves in the plane normal to its hinge axis, it cannot tilt")
     if stopped:
         lines += ["", f"**The run stopped early:** {stopped}"]
-    lines += [
-        "",
-        "## Contact at the retrofitted hinges",
-        "",
-        "| hinge | impacts | peak force [N] | at [ms] | p95 force [N] | in contact | max penetration [µm] |",
-        "|---|---|---|---|---|---|---|",
-    ]
+    lines.append("")
+    if result.joints:
+        lines += [
+            "## Contact at the retrofitted hinges",
+            "",
+            "| hinge | impacts | peak force [N] | at [ms] | p95 force [N] | in contact | max penetration [µm] |",
+            "|---|---|---|---|---|---|---|",
+        ]
     for r in rows:
         lines.append(
             f"| {r.joint} | {r.impacts} | {r.peak_force:.4g} | {r.peak_force_time * 1e3:.4g} | {r.p95_force:.4g} "
             f"| {r.contact_fraction:.1%} | {r.max_penetration * 1e6:.3g} |"
         )
-    lines.append("")
+    if rows:
+        lines.append("")
     clearances = meta.get("radial_clearance", {})
     for hinge in result.joints:
         name = f"orbit_{hinge}.png"
@@ -85,6 +91,7 @@ def write_model_report(
         modes = [contact_modes(result, j, continuous_after=continuous_after) for j in result.joints]
         plot_contact_force(result, startup=startup, modes=modes, path=out / "contact_force.png")
         lines += ["![contact force](contact_force.png)", ""]
+    lines += backlash_section(out, result, backlash_summaries(result))
     if deviation is not None:
         lines += [
             f"## Deviation of {deviation.site} from the unmodified twin",

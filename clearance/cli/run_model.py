@@ -8,7 +8,9 @@ keyframe under the same controls: a control file (a header ``time_s,<actuator>,.
 every actuator once, ``#k`` for an unnamed one; linear interpolation, held beyond its rows)
 or the sinusoid the retrofit was sized from (default). The run's arrays go to
 ``result.npz/json``, the twin's to ``ideal.npz/json``, with ``summary.csv`` (contact
-statistics per hinge), ``site_deviation.csv`` (with ``--site``) and ``report.md`` with its
+statistics per hinge; for a backlash retrofit ``backlash_summary.csv``: per hinge the angle's
+range in the band, the impacts at its ends and the peak stop torque), ``site_deviation.csv``
+(with ``--site``) and ``report.md`` with its
 figures (`clearance.analysis.figures.model_report`); ``--rerun`` also records the bodies of
 both models moving in 3-D with the orbits beside them (`clearance.analysis.recording.model_rerun`).
 """
@@ -16,6 +18,7 @@ both models moving in 3-D with the orbits beside them (`clearance.analysis.recor
 from __future__ import annotations
 
 import argparse
+import math
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -138,6 +141,7 @@ def _run(
     args: argparse.Namespace, loaded: Retrofitted, drive: Drive, sites: list[str], duration: float, out: Path
 ) -> int:
     from clearance.analysis.figures.model_report import write_model_report
+    from clearance.analysis.metrics.backlash_impacts import backlash_summaries, write_backlash_csv
     from clearance.analysis.metrics.site_deviation import site_deviation, write_site_deviation_csv
     from clearance.analysis.metrics.summary import summarise, write_summary_csv
     from clearance.retrofit import SineControl
@@ -145,9 +149,14 @@ def _run(
     from clearance.run.simulation import SimulationError
 
     m = loaded.manifest
+    play = f"radial play at {[h.name for h in m.hinges]}" if m.hinges else ""
+    if m.backlash:
+        arcmin = ", ".join(f"{b.name} +-{b.half_width * 10800 / math.pi:.4g}'" for b in m.backlash)
+        play = f"{play}; " * bool(play) + f"backlash at {arcmin}"
+    kind = f", {m.contact_mode} ring" if m.hinges else ""
     print(
-        f"{loaded.folder}: radial play at {[h.name for h in m.hinges]}, {duration * 1e3:.4g} ms at "
-        f"h = {m.timestep:g} s (the model's own {m.original_timestep:g} s), {m.contact_mode} ring"
+        f"{loaded.folder}: {play}, {duration * 1e3:.4g} ms at h = {m.timestep:g} s (the model's own "
+        f"{m.original_timestep:g} s){kind}"
     )
     failed = None
     try:
@@ -167,6 +176,9 @@ def _run(
     twin.save(out / "ideal")
     rows = summarise(result, None)
     write_summary_csv(rows, out / "summary.csv")
+    backlash = backlash_summaries(result)
+    if backlash:
+        write_backlash_csv(backlash, out / "backlash_summary.csv")
     deviation = None
     if sites and len(result.times) >= 3:
         deviation = site_deviation(result, twin, sites[0])
@@ -187,6 +199,13 @@ def _run(
         print(
             f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, p95 "
             f"{r.p95_force:.4g} N, {r.impacts} impacts, max penetration {r.max_penetration * 1e6:.3g} µm"
+        )
+    for b in backlash:
+        print(
+            f"  {b.hinge}: backlash angle in [{b.min_angle * 10800 / math.pi:.4g}, {b.max_angle * 10800 / math.pi:.4g}]"
+            f"' (band +-{b.half_width * 10800 / math.pi:.4g}'), {b.impacts} impacts at its ends ({b.impacts_upper} at "
+            f"+b, {b.impacts_lower} at -b), peak stop torque {b.peak_torque:.4g} N m at "
+            f"{b.peak_torque_time * 1e3:.3f} ms"
         )
     if deviation is not None:
         axes = ", ".join(f"{k.rsplit('/', 1)[1]} {s.rms_deviation * 1e3:.3g}" for k, s in deviation.axes.items())

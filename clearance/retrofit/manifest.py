@@ -3,7 +3,9 @@
 `retrofit.md` is for people; `retrofit.json` beside it is for `clearance run --model DIR`:
 the model files, the time step the stability rule chose, and per hinge the names of its
 slides, sites and sensors, its clearance and its divergence bound, and where the unmodified
-model's coordinates sit in the retrofitted one.
+model's coordinates sit in the retrofitted one. A backlash retrofit records, per hinge, its
+motor side and dead-band tendon (`BacklashRecord`) and no radial hinges; files written
+before backlash existed have no ``backlash`` field and read as none.
 """
 
 from __future__ import annotations
@@ -16,7 +18,7 @@ from typing import Any
 
 from clearance.retrofit.play import RetrofitError
 
-__all__ = ["MANIFEST_FILE", "FORMAT", "HingeRecord", "RetrofitManifest", "read_manifest"]
+__all__ = ["MANIFEST_FILE", "FORMAT", "BacklashRecord", "HingeRecord", "RetrofitManifest", "read_manifest"]
 
 MANIFEST_FILE = "retrofit.json"
 FORMAT = 1
@@ -54,6 +56,27 @@ class HingeRecord:
 
 
 @dataclass(frozen=True)
+class BacklashRecord:
+    """One hinge with backlash as a run reads it.
+
+    Attributes:
+        name: the hinge (the load side, the link).
+        motor_joint: the motor side's hinge on the same axis (it takes the actuators).
+        motor_body: the motor body.
+        tendon: the dead band's fixed tendon, q_load - q_motor, limited to +-``half_width``.
+        half_width: b [rad].
+        actuators: the actuators moved to the motor side (names, or ``#k``).
+    """
+
+    name: str
+    motor_joint: str
+    motor_body: str
+    tendon: str
+    half_width: float
+    actuators: tuple[str, ...]
+
+
+@dataclass(frozen=True)
 class RetrofitManifest:
     """The machine-readable record of a written retrofit.
 
@@ -65,6 +88,7 @@ class RetrofitManifest:
         contact_mode: 'calibrated' or 'nominal'.
         hinges: the retrofitted hinges, in the order given.
         qpos_map, qvel_map: index in the retrofitted qpos / qvel of each unmodified entry.
+        backlash: the hinges given backlash, in the order given (empty for radial play).
     """
 
     model: str
@@ -75,6 +99,7 @@ class RetrofitManifest:
     hinges: tuple[HingeRecord, ...]
     qpos_map: tuple[int, ...]
     qvel_map: tuple[int, ...]
+    backlash: tuple[BacklashRecord, ...] = ()
 
     def to_json(self) -> str:
         """The file's text."""
@@ -98,6 +123,9 @@ class RetrofitManifest:
                 hinges=hinges,
                 qpos_map=tuple(int(i) for i in raw["qpos_map"]),
                 qvel_map=tuple(int(i) for i in raw["qvel_map"]),
+                backlash=tuple(
+                    BacklashRecord(**{**b, "actuators": tuple(b["actuators"])}) for b in raw.get("backlash", [])
+                ),
             )
         except RetrofitError:
             raise

@@ -19,11 +19,19 @@ import mujoco
 from clearance.results import atomic_write_text
 from clearance.retrofit.assets import relocate_assets
 from clearance.retrofit.backlash import MOTOR_MASS, BacklashRetrofit
-from clearance.retrofit.manifest import MANIFEST_FILE, HingeRecord, RetrofitManifest
+from clearance.retrofit.manifest import MANIFEST_FILE, BacklashRecord, HingeRecord, RetrofitManifest
 from clearance.retrofit.pipeline import Retrofit
 from clearance.retrofit.report import retrofit_report
 
-__all__ = ["MODEL_FILE", "TWIN_FILE", "REPORT_FILE", "manifest_of", "write_backlash", "write_retrofit"]
+__all__ = [
+    "MODEL_FILE",
+    "TWIN_FILE",
+    "REPORT_FILE",
+    "backlash_manifest_of",
+    "manifest_of",
+    "write_backlash",
+    "write_retrofit",
+]
 
 MODEL_FILE = "model.xml"
 TWIN_FILE = "original.xml"
@@ -99,10 +107,10 @@ def write_backlash(
     source: str = "",
     command: str = "",
 ) -> dict[str, Path]:
-    """Write ``model.xml``, ``original.xml`` and ``retrofit.md`` of a backlash edit into ``out_dir``.
+    """Write ``model.xml``, ``original.xml``, ``retrofit.md`` and ``retrofit.json`` of a backlash edit.
 
-    No ``retrofit.json``: ``clearance run --model`` reads radial play only. Arguments as
-    `write_retrofit`'s; returns file role ('model', 'original', 'report') -> path.
+    Arguments as `write_retrofit`'s; returns file role ('model', 'original', 'report',
+    'manifest') -> path. ``clearance run --model`` reads the manifest (`backlash_manifest_of`).
 
     Raises:
         RuntimeError: the written model does not compile from its file.
@@ -112,6 +120,8 @@ def write_backlash(
     src = Path(source_dir if source_dir is not None else (result.twin_spec.modelfiledir or "."))
     paths = {"model": out / MODEL_FILE, "original": out / TWIN_FILE, "report": out / REPORT_FILE}
     changes = _write_models(result.spec, result.twin_spec, src, out, paths)
+    paths["manifest"] = out / MANIFEST_FILE
+    atomic_write_text(paths["manifest"], backlash_manifest_of(result).to_json())
     lines = ["# Backlash retrofit", ""]
     if source:
         lines.append(f"Model: `{source}`" + (f"; command: `{command}`" if command else ""))
@@ -165,4 +175,35 @@ def manifest_of(result: Retrofit) -> RetrofitManifest:
         hinges=hinges,
         qpos_map=tuple(int(i) for i in result.cmap.qpos),
         qvel_map=tuple(int(i) for i in result.cmap.qvel),
+    )
+
+
+def backlash_manifest_of(result: BacklashRetrofit) -> RetrofitManifest:
+    """The machine-readable record of a backlash edit: no radial hinges, a `BacklashRecord` per hinge,
+    the model's own time step, and where each of the unmodified model's joints sits in the edited one."""
+    model, twin = result.model, result.twin
+    motors = {model.joint(h.motor_joint).id for h in result.hinges.values()}
+    kept = [j for j in range(model.njnt) if j not in motors]  # a motor body adds one hinge; the rest keep their order
+    qpos: list[int] = []
+    qvel: list[int] = []
+    for j, jm in enumerate(kept):
+        nq = (int(twin.jnt_qposadr[j + 1]) if j + 1 < twin.njnt else twin.nq) - int(twin.jnt_qposadr[j])
+        nv = (int(twin.jnt_dofadr[j + 1]) if j + 1 < twin.njnt else twin.nv) - int(twin.jnt_dofadr[j])
+        qpos += range(int(model.jnt_qposadr[jm]), int(model.jnt_qposadr[jm]) + nq)
+        qvel += range(int(model.jnt_dofadr[jm]), int(model.jnt_dofadr[jm]) + nv)
+    records = tuple(
+        BacklashRecord(h.name, h.motor_joint, h.motor_body, h.tendon, h.backlash.half_width, h.actuators)
+        for h in result.hinges.values()
+    )
+    step = float(model.opt.timestep)
+    return RetrofitManifest(
+        model=MODEL_FILE,
+        original=TWIN_FILE,
+        timestep=step,
+        original_timestep=float(twin.opt.timestep),
+        contact_mode="backlash",
+        hinges=(),
+        qpos_map=tuple(qpos),
+        qvel_map=tuple(qvel),
+        backlash=records,
     )

@@ -14,7 +14,9 @@ centre in its bearing frame (the eccentricity sensor; its rate is the slides' ve
 whose axes are the bearing frame's), the penetration |e| - c and the net contact force on
 the journal rotated into the bearing frame. The world positions of the sites asked for (a
 site, or a body's origin where no site has the name: gymnasium's reacher names its tip a
-body) are ``outputs`` ``site/<name>/x``, ``/y`` and ``/z``.
+body) are ``outputs`` ``site/<name>/x``, ``/y`` and ``/z``. A backlash retrofit's run has no
+journals: per backlashed hinge its outputs ``backlash/<hinge>/angle`` (q_load - q_motor) and
+``backlash/<hinge>/torque`` (the stop's torque; `clearance.run.backlash_readout`).
 """
 
 from __future__ import annotations
@@ -31,14 +33,22 @@ import numpy as np
 from clearance.contact_plugin.attributes import sensor_offsets
 from clearance.results import JointResult, SimulationResult
 from clearance.retrofit.drive import Drive, drive_controls
-from clearance.retrofit.manifest import HingeRecord, RetrofitManifest, read_manifest
+from clearance.retrofit.manifest import BacklashRecord, HingeRecord, RetrofitManifest, read_manifest
 from clearance.retrofit.motion import initial_data
 from clearance.retrofit.play import RetrofitError
+from clearance.run.backlash_readout import BacklashReader, add_backlash_sensors
 from clearance.run.readout import _exact_contact_force
 from clearance.run.simulation import SimulationError, StepFailure, model_stepper
 from clearance.version import __version__
 
-__all__ = ["Retrofitted", "load_retrofitted", "point_of", "simulate_retrofitted", "site_output_names"]
+__all__ = [
+    "Retrofitted",
+    "load_retrofitted",
+    "point_of",
+    "retrofitted",
+    "simulate_retrofitted",
+    "site_output_names",
+]
 
 
 @dataclass
@@ -100,15 +110,33 @@ def load_retrofitted(path: str | os.PathLike[str]) -> Retrofitted:
     for name in (manifest.model, manifest.original):
         file = folder / name
         try:
-            models.append(mujoco.MjModel.from_xml_path(str(file)))
+            spec = mujoco.MjSpec.from_file(str(file))
+            if name == manifest.model:
+                add_backlash_sensors(spec, manifest.backlash)
+            models.append(spec.compile())
         except ValueError as err:
             raise RetrofitError(f"{file} does not compile: {err}") from None
     model, twin = models
-    if (model.nq, model.nv) != (twin.nq + 2 * len(manifest.hinges), twin.nv + 2 * len(manifest.hinges)):
+    added = 2 * len(manifest.hinges) + len(manifest.backlash)
+    if (model.nq, model.nv) != (twin.nq + added, twin.nv + added):
         raise RetrofitError(f"{folder}: model.xml and original.xml do not match {folder / 'retrofit.json'}")
+    return retrofitted(folder, manifest, model, twin)
+
+
+def retrofitted(
+    folder: str | os.PathLike[str], manifest: RetrofitManifest, model: mujoco.MjModel, twin: mujoco.MjModel
+) -> Retrofitted:
+    """A retrofit held in memory (its models compiled; a backlash model with `add_backlash_sensors`),
+    both models set to the manifest's time step, as `load_retrofitted` returns one read from files.
+
+    Args:
+        folder: where it came from (a model file's folder), for messages and metadata.
+        manifest: its record (`clearance.retrofit.output.manifest_of` or `backlash_manifest_of`).
+        model, twin: the retrofitted and the unmodified model (their time steps are set here).
+    """
     model.opt.timestep = manifest.timestep
     twin.opt.timestep = manifest.timestep
-    return Retrofitted(folder, manifest, model, twin)
+    return Retrofitted(Path(folder), manifest, model, twin)
 
 
 def site_output_names(site: str) -> list[str]:
@@ -150,11 +178,12 @@ def simulate_retrofitted(
     loaded.check_sites(sites)
     model = loaded.twin if twin else loaded.model
     hinges = () if twin else loaded.manifest.hinges
+    backlash = () if twin else loaded.manifest.backlash
     h = float(model.opt.timestep)
     nstep = max(1, int(round(duration / h)))
     every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
     data = initial_data(model)
-    reader = _Reader(model, hinges, sites)
+    reader = _Reader(model, hinges, sites, backlash)
     step = model_stepper(model, data)
     parts: list[SimulationResult] = []
     qpos_before = data.qpos.copy()
@@ -203,6 +232,8 @@ def _remedy(loaded: Retrofitted, twin: bool) -> str:
     h = loaded.manifest.timestep
     if twin:
         return f"the unmodified model does not run at the retrofit's step {h:g} s under these controls; check them"
+    if not loaded.manifest.hinges:
+        return "drive the model more gently (a smaller --sine-amplitude), or give the hinges a wider backlash band"
     return (
         f"retrofit again with a smaller time step (--timestep-us {h * 1e6 / 2:g}; now {h * 1e6:g}) or more ring "
         "segments (--segments), or drive the model more gently"
@@ -237,8 +268,15 @@ def _first_bad(
 class _Reader:
     """Sensor and position rows -> a `SimulationResult` chunk."""
 
-    def __init__(self, model: mujoco.MjModel, hinges: Sequence[HingeRecord], sites: Sequence[str]) -> None:
+    def __init__(
+        self,
+        model: mujoco.MjModel,
+        hinges: Sequence[HingeRecord],
+        sites: Sequence[str],
+        backlash: Sequence[BacklashRecord] = (),
+    ) -> None:
         self.model, self.hinges, self.sites = model, hinges, list(sites)
+        self.backlash = BacklashReader(model, backlash)
         self.data = mujoco.MjData(model)
 
         def sensor(name: str) -> slice:
@@ -293,6 +331,7 @@ class _Reader:
         for k, s in enumerate(self.sites):
             for a, name in enumerate(site_output_names(s)):
                 outputs[name] = site_pos[:, k, a].copy()
+        outputs.update(self.backlash.read(sens, q))
         return SimulationResult(
             times=np.asarray(times, dtype=float),
             outputs=outputs,
@@ -330,6 +369,7 @@ def _finish(
         "contact_mode": m.contact_mode,
         "clearance_joints": [] if twin else [h.name for h in m.hinges],
         "radial_clearance": {} if twin else {h.name: h.radial_clearance for h in m.hinges},
+        "backlash": {} if twin else {b.name: b.half_width for b in m.backlash},
         "bodies": [mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, b) or f"#{b}" for b in range(model.nbody)],
         "sites": list(sites),
         "drive": getattr(drive, "source", "") or repr(drive),
