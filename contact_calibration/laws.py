@@ -34,6 +34,9 @@ from clearance.model import Clearance, ContactLaw, Material
 
 __all__ = [
     "contact_omega",
+    "GEAR_MESH_EXPONENT",
+    "mesh_torque",
+    "mesh_omega",
     "bearing_stiffness",
     "bearing_stiffness_from",
     "hertz",
@@ -590,3 +593,61 @@ def contact_omega(stiffness: float, penetration: float, mass: float) -> float:
         mass: effective mass along the contact normal [kg].
     """
     return math.sqrt(1.5 * stiffness * math.sqrt(penetration) / mass)
+
+
+GEAR_MESH_EXPONENT = 1.0
+"""Exponent n of a gear mesh's torsional stop [-]: a tooth pair in contact is a line contact
+whose load grows about linearly with its deflection, so the mesh is a linear torsional
+spring (the mesh stiffness of gear standards is a constant per unit face width)."""
+
+
+def mesh_torque(
+    delta: ArrayLike,
+    delta_dot: ArrayLike,
+    approach_rate: ArrayLike,
+    *,
+    stiffness: float,
+    restitution: float,
+    exponent: float = GEAR_MESH_EXPONENT,
+) -> Force:
+    """Torque of a backlash stop, Lankarani–Nikravesh in angular form: T = K δⁿ [1 + 3(1 − cₑ²)/4 · δ̇/δ̇⁻].
+
+    δ = |θ_load − θ_motor| − b [rad] is the angular penetration past the dead band of
+    half-width b, δ̇ its rate [rad/s] (> 0 closing) and δ̇⁻ the closing rate at the stop's
+    onset; K [N m/rad^n] the torsional mesh stiffness. The same law, hysteresis factor and
+    clipping as `lankarani_nikravesh`, with torque for force and angle for length.
+
+    Args:
+        delta: angular penetration δ [rad], any shape; T = 0 where δ <= 0.
+        delta_dot: its rate δ̇ [rad/s] (> 0 closing), broadcast with ``delta``.
+        approach_rate: δ̇⁻ [rad/s], > 0, the closing rate at onset.
+        stiffness: K [N m/rad^n], > 0.
+        restitution: cₑ [-], [0, 1].
+        exponent: n [-], > 0 (`GEAR_MESH_EXPONENT` = 1 for a gear mesh).
+
+    Returns:
+        Torque [N m] >= 0 (float for scalars).
+
+    Raises:
+        ValueError: if an argument is out of range.
+    """
+    return _law(ContactLaw.LANKARANI_NIKRAVESH, delta, delta_dot, approach_rate, stiffness, restitution, exponent)
+
+
+def mesh_omega(stiffness: float, penetration: float, inertia: float, exponent: float = GEAR_MESH_EXPONENT) -> float:
+    """Frequency ω = sqrt(k_t / J) [rad/s] of a backlash stop at an angular penetration.
+
+    k_t = n K δ^(n−1) is the tangent stiffness of K δⁿ at δ [N m/rad] (K itself for the
+    linear gear mesh, n = 1); J the effective inertia along the band [kg m^2]. Explicit
+    stepping is stable for ω h < 2, as for `contact_omega`.
+
+    Args:
+        stiffness: K [N m/rad^n], > 0.
+        penetration: δ [rad], > 0.
+        inertia: J [kg m^2], > 0.
+        exponent: n [-], > 0.
+    """
+    k = positive("stiffness", stiffness, "N m/rad^n")
+    n = positive("exponent", exponent, "")
+    d = positive("penetration", penetration, "rad")
+    return math.sqrt(n * k * d ** (n - 1.0) / positive("inertia", inertia, "kg m^2"))

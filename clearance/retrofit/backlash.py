@@ -7,7 +7,17 @@ at the link's frame) with a hinge ``<hinge>__motor`` on the same axis; the model
 on the hinge are moved to it. The dead band is a fixed tendon
 ``clr_<hinge>__backlash`` = q_load - q_motor, limited to [-b, b]: the two coincident hinges
 and a limit of MuJoCo's recipe, with the limit on their difference so neither angle changes
-meaning. The stop is the tendon limit's constraint at MuJoCo's defaults (not calibrated).
+meaning. The stop at either end of the band is calibrated (`Backlash.stop` = 'calibrated'):
+the tendon limit's solreflimit and solimplimit fitted to the gear mesh's impact law at the
+band's effective inertia, and the model's time step lowered where the stop needs it
+(`clearance.retrofit.backlash_stop`); or MuJoCo's default limit at the model's step, the
+recipe as users write it ('recipe').
+
+A limited hinge's limit is copied to its motor hinge (range, solref, solimp, margin): the
+twin's limit stopped the link with the rotor's inertia behind it, and MuJoCo's limit is
+normalised by the inertia it acts on, so on the light link alone it would let the motor push
+the link far through its range; on the motor side it stops the drive where the twin's joint
+stopped, and the load stays within +-b of it.
 
 The motor body carries no mass (`MOTOR_MASS`, MuJoCo's floor requires some); the motor's
 inertia is its hinge's armature: the hinge's own armature moved to the motor side (the
@@ -23,6 +33,8 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from clearance.contact_calibration.torsional_stop import OMEGA_H
+from clearance.retrofit.backlash_stop import Band, BandStop, calibrate_stops
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.play import PREFIX, Backlash, RetrofitError
 from clearance.retrofit.selection import compile_model, model_label
@@ -79,6 +91,7 @@ class BacklashHinge:
         motor_armature: the motor hinge's armature [kg m^2].
         armature_source: where it came from ('the hinge's armature (moved)', 'given', or the
             fraction of the hinge's inertia).
+        stop: the stop at the ends of the band (its inertia, impact speed and fit).
     """
 
     name: str
@@ -89,6 +102,7 @@ class BacklashHinge:
     actuators: tuple[str, ...]
     motor_armature: float
     armature_source: str
+    stop: BandStop
 
 
 @dataclass
@@ -101,6 +115,7 @@ class BacklashRetrofit:
         hinges: hinge name -> what was added for it, in the order given.
         keyframes: keyframes extended (each motor angle and speed = its load's: the band centred).
         notes: remarks for a report.
+        timestep: the model's time step [s] (the twin's, or lower where a calibrated stop needs it).
     """
 
     spec: mujoco.MjSpec
@@ -110,6 +125,7 @@ class BacklashRetrofit:
     hinges: dict[str, BacklashHinge]
     keyframes: int
     notes: list[str] = field(default_factory=list)
+    timestep: float = 0.0
 
 
 def _actuator_label(model: mujoco.MjModel, k: int) -> str:
@@ -198,7 +214,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     old_bodies = sorted(bodies)
     actuators = {int(a.id): a for a in work.actuators}
     cls = add_builtin_class(work)
-    done: dict[str, BacklashHinge] = {}
+    pending: dict[str, tuple[str, Backlash, str, str, str, tuple[str, ...], float, str]] = {}
     for name, play in joints.items():
         j = mujoco.mj_name2id(twin, mujoco.mjtObj.mjOBJ_JOINT, name)
         body = int(twin.jnt_bodyid[j])
@@ -232,6 +248,11 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
             axis=twin.jnt_axis[j],
             armature=armature,
             damping=damping,
+            limited=mujoco.mjtLimited.mjLIMITED_TRUE if twin.jnt_limited[j] else mujoco.mjtLimited.mjLIMITED_FALSE,
+            range=twin.jnt_range[j],
+            solref_limit=twin.jnt_solref[j],
+            solimp_limit=twin.jnt_solimp[j],
+            margin=twin.jnt_margin[j],
         )
         tendon = f"{PREFIX}{name}__backlash"
         band = work.add_tendon(
@@ -241,7 +262,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
         band.wrap_joint(motor_joint_name(name), -1.0)
         for k in actuated[name]:
             actuators[k].target = motor_joint_name(name)
-        done[name] = BacklashHinge(
+        pending[name] = (
             name,
             play,
             motor_joint_name(name),
@@ -252,6 +273,24 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
             source,
         )
     kinematic = compile_model(work)
+    bands = {
+        name: Band(
+            tendon=int(kinematic.tendon(f"{PREFIX}{name}__backlash").id),
+            load_dof=int(kinematic.joint(name).dofadr[0]),
+            motor_dof=int(kinematic.joint(motor_joint_name(name)).dofadr[0]),
+            actuators=tuple(int(k) for k in actuated[name]),
+            backlash=play,
+        )
+        for name, play in joints.items()
+    }
+    timestep, stops = calibrate_stops(kinematic, bands)
+    for name, stop in stops.items():
+        if stop.solref is not None and stop.solimp is not None:
+            tendon = work.tendon(f"{PREFIX}{name}__backlash")
+            tendon.solref_limit = list(stop.solref)
+            tendon.solimp_limit = list(stop.solimp)
+    work.option.timestep = timestep
+    done = {name: BacklashHinge(*pending[name], stops[name]) for name in joints}
     nkeys = _extend_keyframes(work, twin, kinematic, old_joints, done)
     model = compile_model(work)
     kept = np.array([int(bodies[b].id) for b in old_bodies])
@@ -262,10 +301,27 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     notes = [
         f"hinge '{h.name}': actuators {', '.join(h.actuators)} moved to '{h.motor_joint}' (armature "
         f"{h.motor_armature:.4g} kg m^2, {h.armature_source}); dead band +-{h.backlash.half_width:.4g} rad by the "
-        f"limit of tendon '{h.tendon}' at MuJoCo's default stop (not calibrated); sensors stay on the load side"
+        f"limit of tendon '{h.tendon}', {_stop_note(h.stop)}; sensors stay on the load side"
         for h in done.values()
     ]
-    return BacklashRetrofit(work, model, twin_spec, twin, done, nkeys, notes)
+    if timestep < twin.opt.timestep:
+        notes.append(
+            f"time step lowered from {twin.opt.timestep:g} s to {timestep:g} s for the calibrated stops "
+            f"(omega*h <= {OMEGA_H:g} with omega = sqrt(K/J)); run the twin at this step to compare"
+        )
+    return BacklashRetrofit(work, model, twin_spec, twin, done, nkeys, notes, timestep)
+
+
+def _stop_note(stop: BandStop) -> str:
+    """One line on a band's stop."""
+    if stop.fit is None:
+        return f"MuJoCo's default stop (the recipe, not calibrated; effective inertia {stop.inertia:.4g} kg m^2)"
+    worst = max(max(abs(r.peak_torque_err), abs(r.restitution_err)) for r in stop.fit.rows)
+    return (
+        f"stop calibrated to K = {stop.fit.law.stiffness:.4g} N m/rad, e = {stop.fit.law.restitution:g} at J = "
+        f"{stop.inertia:.4g} kg m^2 over {stop.fit.speeds[0]:.3g}..{stop.fit.speeds[-1]:.3g} rad/s (worst error "
+        f"{100 * worst:.2f} %)"
+    )
 
 
 def _extend_keyframes(

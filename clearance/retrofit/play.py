@@ -20,7 +20,10 @@ from clearance.options import ContactMode, GeomType
 
 __all__ = [
     "Backlash",
+    "DEFAULT_MESH_RESTITUTION",
+    "DEFAULT_MESH_STIFFNESS",
     "MAX_BACKLASH",
+    "STOPS",
     "DEFAULT_BEARING_RADIUS",
     "DEFAULT_CLASS",
     "DEFAULT_RADIAL_CLEARANCE",
@@ -120,13 +123,31 @@ MAX_BACKLASH = math.radians(10.0)
 a loose coupling rather than gear play."""
 
 
+DEFAULT_MESH_STIFFNESS = 1e4
+"""Torsional mesh stiffness K of a backlash stop when none is given [N m/rad]: the order of a
+small robot gearbox's torsional stiffness (strain-wave gear catalogues give about 0.3e4 to
+2.5e4 N m/rad for sizes 14 to 20 at low load; recalled, not checked)."""
+
+DEFAULT_MESH_RESTITUTION = 0.8
+"""Coefficient of restitution cₑ of a backlash stop when none is given [-]: lubricated steel
+teeth, as gear-rattle models take it (about 0.6 to 0.9; recalled, not checked), in the range
+where Lankarani–Nikravesh holds (cₑ >= 0.7)."""
+
+STOPS = ("calibrated", "recipe")
+"""What closes a dead band: 'calibrated' (the tendon limit fitted to the mesh law,
+`clearance.contact_calibration.torsional_stop`) or 'recipe' (the same limit at MuJoCo's
+default solref and solimp, the two-hinges-and-a-limit recipe, and the model's time step)."""
+
+
 @dataclass(frozen=True)
 class Backlash:
     """Angular play (gear backlash) of one actuated hinge: a dead band of +-b between motor and link.
 
     The hinge keeps its name and its body (the link, the load side); a motor side on the same
     axis takes the model's actuators, and the load may turn within +-b of the motor
-    (`clearance.retrofit.backlash`).
+    (`clearance.retrofit.backlash`). At either end of the band the teeth meet: the stop
+    follows Lankarani–Nikravesh in angular form, T = K δⁿ [1 + 3(1 − cₑ²)/4 · δ̇/δ̇⁻],
+    δ = |q_load − q_motor| − b (`clearance.contact_calibration.laws.mesh_torque`).
 
     Attributes:
         half_width: b [rad], in (0, `MAX_BACKLASH`].
@@ -134,10 +155,21 @@ class Backlash:
             inertia); None: the hinge's own ``armature`` moves to the motor side, or where the
             hinge has none, `clearance.retrofit.backlash.MOTOR_ARMATURE_FRACTION` of the
             hinge's inertia at the model's reference pose.
+        mesh_stiffness: K [N m/rad^n], > 0 (`DEFAULT_MESH_STIFFNESS`, 1e4 N m/rad).
+        restitution: cₑ [-], in (0, 1] (`DEFAULT_MESH_RESTITUTION`, 0.8).
+        mesh_exponent: n [-], > 0 (1: a gear mesh is a linear spring).
+        impact_speed: the closing speed the stop is fitted around [rad/s] (a decade about it);
+            None: estimated from the model (`clearance.retrofit.backlash.impact_speed`).
+        stop: one of `STOPS` ('calibrated' unless 'recipe' is asked for).
     """
 
     half_width: float
     motor_armature: float | None = None
+    mesh_stiffness: float = DEFAULT_MESH_STIFFNESS
+    restitution: float = DEFAULT_MESH_RESTITUTION
+    mesh_exponent: float = 1.0
+    impact_speed: float | None = None
+    stop: str = "calibrated"
 
     def __post_init__(self) -> None:
         b = finite("backlash half_width", self.half_width)
@@ -147,11 +179,29 @@ class Backlash:
             )
         if self.motor_armature is not None:
             positive("motor_armature", self.motor_armature, "kg m^2")
+        positive("mesh_stiffness", self.mesh_stiffness, "N m/rad")
+        positive("mesh_exponent", self.mesh_exponent, "")
+        e = finite("restitution", self.restitution)
+        if not 0 < e <= 1:
+            raise RetrofitError(f"backlash restitution must be in (0, 1] (got {self.restitution!r})")
+        if self.impact_speed is not None:
+            positive("impact_speed", self.impact_speed, "rad/s")
+        if self.stop not in STOPS:
+            raise RetrofitError(f"backlash stop must be one of {', '.join(STOPS)} (got {self.stop!r})")
 
     @classmethod
-    def from_arcmin(cls, half_width_arcmin: float, motor_armature: float | None = None) -> Backlash:
+    def from_arcmin(
+        cls,
+        half_width_arcmin: float,
+        motor_armature: float | None = None,
+        *,
+        mesh_stiffness: float = DEFAULT_MESH_STIFFNESS,
+        restitution: float = DEFAULT_MESH_RESTITUTION,
+        stop: str = "calibrated",
+    ) -> Backlash:
         """A backlash from its half-width in arc-minutes."""
-        return cls(math.radians(finite("backlash_arcmin", half_width_arcmin) / 60.0), motor_armature)
+        b = math.radians(finite("backlash_arcmin", half_width_arcmin) / 60.0)
+        return cls(b, motor_armature, mesh_stiffness=mesh_stiffness, restitution=restitution, stop=stop)
 
 
 @dataclass(frozen=True)

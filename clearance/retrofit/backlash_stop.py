@@ -1,0 +1,170 @@
+"""The stops at the ends of each backlash band: the effective inertia, the impact speeds, the fit.
+
+For each band (the fixed tendon q_load - q_motor of `clearance.retrofit.backlash`) on the
+model with its motor bodies added:
+
+- the effective inertia along the band, J = 1/(J_t M⁻¹ J_tᵀ) with the tendon's Jacobian J_t and
+  the mass matrix M at the model's reference pose (qpos0): the link's inertia and the motor's
+  armature (the rotor's reflected inertia) in series, with whatever the rest of the model
+  couples to them;
+- the closing speed the stop is fitted around, unless given: the speed at which the motor,
+  pushed from rest by its actuators' largest torque, takes up the whole band 2b while the load
+  stands, v = sqrt(2 · 2b · a) with a the band's acceleration per that torque (M⁻¹ along the
+  band). Where the actuators' torque is unbounded (no control or force range) the speed is
+  `FALLBACK_IMPACT_SPEED`, and the record says so;
+- for a 'calibrated' stop, the time step (`torsional_stop.stop_timestep`, the smallest over
+  the bands) and the fit of the tendon limit's solreflimit and solimplimit to the mesh law over
+  a decade of closing speeds (`torsional_stop.fit_stop`) at that step and the model's
+  integrator. A 'recipe' stop keeps MuJoCo's default limit and the model's step.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from clearance.contact_calibration.torsional_stop import (
+    MeshLaw,
+    TorsionalStop,
+    fit_stop,
+    stop_solimp,
+    stop_solref,
+    stop_speeds,
+    stop_timestep,
+)
+from clearance.retrofit.play import Backlash
+
+__all__ = ["FALLBACK_IMPACT_SPEED", "Band", "BandStop", "band_inertia", "calibrate_stops", "impact_speed"]
+
+FALLBACK_IMPACT_SPEED = 1.0
+"""Closing speed [rad/s] a stop is fitted around where the actuators' torque is unbounded."""
+
+
+@dataclass(frozen=True)
+class Band:
+    """Where one band sits in the compiled model.
+
+    Attributes:
+        tendon: the band's tendon id. load_dof, motor_dof: the two hinges' dofs.
+        actuators: ids of the actuators on the motor hinge. backlash: what was asked.
+    """
+
+    tendon: int
+    load_dof: int
+    motor_dof: int
+    actuators: tuple[int, ...]
+    backlash: Backlash
+
+
+@dataclass(frozen=True)
+class BandStop:
+    """The stop of one band.
+
+    Attributes:
+        kind: 'calibrated' or 'recipe'.
+        inertia: effective inertia J along the band at the reference pose [kg m^2].
+        invweight: the tendon's inverse weight Â at qpos0 (MuJoCo's ``tendon_invweight0``) [1/(kg m^2)].
+        impact_speed: the closing speed fitted around [rad/s].
+        speed_source: how ``impact_speed`` was found.
+        fit: the fitted stop (None for 'recipe').
+        solref: solreflimit emitted (None: MuJoCo's default).
+        solimp: solimplimit emitted (None: MuJoCo's default).
+    """
+
+    kind: str
+    inertia: float
+    invweight: float
+    impact_speed: float
+    speed_source: str
+    fit: TorsionalStop | None
+    solref: tuple[float, float] | None
+    solimp: tuple[float, float, float, float, float] | None
+
+
+def _inverse_mass_along(model: mujoco.MjModel, band: Band) -> np.ndarray:
+    """M⁻¹ J_tᵀ at qpos0 for the band's tendon (+1 on the load dof, -1 on the motor dof)."""
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    jac = np.zeros(model.nv)
+    jac[band.load_dof], jac[band.motor_dof] = 1.0, -1.0
+    out = np.zeros(model.nv)
+    mujoco.mj_solveM(model, data, out.reshape(1, -1), jac.reshape(1, -1))
+    return out
+
+
+def band_inertia(model: mujoco.MjModel, band: Band) -> float:
+    """Effective inertia along the band, 1/(J_t M⁻¹ J_tᵀ) at qpos0 [kg m^2]."""
+    x = _inverse_mass_along(model, band)
+    return 1.0 / float(x[band.load_dof] - x[band.motor_dof])
+
+
+def _actuator_torque(model: mujoco.MjModel, k: int) -> float | None:
+    """Largest torque actuator ``k`` applies on its joint [N m]; None where unbounded or not a plain gain."""
+    gear = abs(float(model.actuator_gear[k, 0]))
+    force = math.inf
+    if model.actuator_forcelimited[k]:
+        force = float(np.max(np.abs(model.actuator_forcerange[k])))
+    if (
+        model.actuator_ctrllimited[k]
+        and int(model.actuator_gaintype[k]) == int(mujoco.mjtGain.mjGAIN_FIXED)
+        and int(model.actuator_dyntype[k]) == int(mujoco.mjtDyn.mjDYN_NONE)
+    ):
+        force = min(
+            force, abs(float(model.actuator_gainprm[k, 0])) * float(np.max(np.abs(model.actuator_ctrlrange[k])))
+        )
+    return gear * force if math.isfinite(force) else None
+
+
+def impact_speed(model: mujoco.MjModel, band: Band) -> tuple[float, str]:
+    """(closing speed [rad/s], how it was found) the band's stop is fitted around (module docstring)."""
+    if band.backlash.impact_speed is not None:
+        return band.backlash.impact_speed, "given"
+    torques = [_actuator_torque(model, k) for k in band.actuators]
+    if any(t is None for t in torques) or not torques:
+        return FALLBACK_IMPACT_SPEED, f"{FALLBACK_IMPACT_SPEED:g} rad/s (the actuators' torque is unbounded)"
+    torque = float(sum(t for t in torques if t is not None))
+    accel = torque * abs(float(_inverse_mass_along(model, band)[band.motor_dof]))
+    if not accel > 0:
+        return FALLBACK_IMPACT_SPEED, f"{FALLBACK_IMPACT_SPEED:g} rad/s (the actuators' torque is zero)"
+    v = math.sqrt(4.0 * band.backlash.half_width * accel)
+    return v, f"the band 2b crossed from rest under the actuators' largest torque {torque:.4g} N m"
+
+
+def calibrate_stops(model: mujoco.MjModel, bands: Mapping[str, Band]) -> tuple[float, dict[str, BandStop]]:
+    """(time step [s], hinge -> its stop) for the bands of ``model`` (module docstring).
+
+    Raises:
+        StopStabilityError: a calibrated stop needs a step below the smallest allowed, or its
+            fit is unstable at the step.
+    """
+    laws = {
+        name: MeshLaw(b.backlash.mesh_stiffness, b.backlash.restitution, b.backlash.mesh_exponent)
+        for name, b in bands.items()
+    }
+    inertia = {name: band_inertia(model, b) for name, b in bands.items()}
+    step = float(model.opt.timestep)
+    for name, b in bands.items():
+        if b.backlash.stop == "calibrated":
+            step = min(step, stop_timestep(laws[name], inertia[name], float(model.opt.timestep)))
+    out: dict[str, BandStop] = {}
+    for name, b in bands.items():
+        speed, source = impact_speed(model, b)
+        invweight = float(model.tendon_invweight0[b.tendon])
+        if b.backlash.stop != "calibrated":
+            out[name] = BandStop("recipe", inertia[name], invweight, speed, source, None, None, None)
+            continue
+        fit = fit_stop(
+            laws[name],
+            inertia=inertia[name],
+            half_width=b.backlash.half_width,
+            speeds=stop_speeds(speed),
+            timestep=step,
+            integrator=int(model.opt.integrator),
+        )
+        solref = stop_solref(fit.stiffness, fit.damping, invweight)
+        out[name] = BandStop("calibrated", inertia[name], invweight, speed, source, fit, solref, stop_solimp())
+    return step, out
