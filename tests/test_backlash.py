@@ -159,7 +159,7 @@ def test_cli_writes_the_reacher_with_backlash(tmp_path, capsys):
         rel=1e-6,  # MuJoCo's MJCF writer keeps 6 significant digits
     )
     report = (out / "retrofit.md").read_text()
-    assert "| joint1 | 5 | joint1__motor |" in report and "not calibrated" in report
+    assert "| joint1 | 5 | joint1__motor |" in report and "| joint1 | calibrated | 10000 | 0.8 | 1 |" in report
     assert "moved to 'joint0__motor'" in stdout
 
 

@@ -19,6 +19,7 @@ import numpy as np
 import pytest
 from gym_assets import gym_model
 
+from clearance.cli import main
 from clearance.contact_calibration.impact import law_impact
 from clearance.contact_calibration.torsional_stop import OMEGA_H, StopStabilityError
 from clearance.model import ContactLaw
@@ -151,3 +152,35 @@ def test_reacher_runs_one_second_with_calibrated_stops_at_both_hinges():
     # each band closes (the motor drives its link through the stop) and opens by no more than the stop's
     # penetration under the 200 N m drive; 3 b bounds it (measured 1.1 b and 1.9 b)
     assert (widest >= b).all() and (widest < 3 * b).all()
+
+
+def test_cli_takes_the_mesh_and_the_recipe_and_reports_the_stop_against_the_law(tmp_path, capsys):
+    argv = ["retrofit", str(gym_model("reacher"))]
+    mesh = "joint1:backlash_arcmin=5,mesh_stiffness=2e3,restitution=0.9"
+    assert main([*argv, "--out", str(tmp_path / "cal"), "--joint", mesh]) == 0
+    written = mujoco.MjModel.from_xml_path(str(tmp_path / "cal" / "model.xml"))
+    report = (tmp_path / "cal" / "retrofit.md").read_text()
+    assert "| joint1 | calibrated | 2000 | 0.9 | 1 |" in report and "goal 5 %; met" in report
+    assert "the band 2b crossed from rest" in report and "lowered from the model's 0.01 s" in report
+    assert written.opt.timestep < 0.01 and written.tendon_solref_lim[0, 0] < 0  # direct mode: -stiffness
+    assert main([*argv, "--out", str(tmp_path / "rec"), "--joint", mesh, "--backlash-stop", "recipe"]) == 0
+    recipe = mujoco.MjModel.from_xml_path(str(tmp_path / "rec" / "model.xml"))
+    assert recipe.opt.timestep == 0.01 and recipe.tendon_solref_lim[0].tolist() == [0.02, 1.0]
+    assert "recipe (MuJoCo's default limit)" in (tmp_path / "rec" / "retrofit.md").read_text()
+    capsys.readouterr()
+
+
+@pytest.mark.parametrize(
+    ("joint", "expected"),
+    [
+        ("joint0:backlash_arcmin=5,mesh_stiffness=0", "mesh_stiffness must be > 0"),
+        ("joint0:backlash_arcmin=5,restitution=1.5", "restitution must be in (0, 1]"),
+        ("joint0:mesh_stiffness=1e4", "give backlash_arcmin too"),
+    ],
+)
+def test_cli_refuses_a_bad_mesh_before_any_work(tmp_path, capsys, joint, expected):
+    out = tmp_path / "out"
+    assert main(["retrofit", str(gym_model("reacher")), "--out", str(out), "--joint", joint]) == 2
+    err = capsys.readouterr().err
+    assert expected in err and err.count("\n") == 1 and "Traceback" not in err
+    assert not out.exists()

@@ -9,9 +9,13 @@ hinge's play; a hinge's own values follow its name, with units in the keys:
 ``--joint elbow:clearance_mm=0.2,bearing_radius_mm=8,youngs_modulus_gpa=2.4``.
 
 ``--joint elbow:backlash_arcmin=5`` gives an actuated hinge gear backlash instead: a motor side
-that takes its actuators, the hinge (the link) turning within +-5' of it, the stop at MuJoCo's
-default limit (`clearance.retrofit.backlash`); every --joint then names backlash, and the
-play, numerics and sizing options do not apply.
+that takes its actuators, the hinge (the link) turning within +-5' of it (`clearance.retrofit.backlash`).
+The stop at either end of the band is calibrated to the gear mesh's impact law with
+``mesh_stiffness`` K [N m/rad] (default 1e4: a small robot gearbox's torsional stiffness, as
+strain-wave gear catalogues give it, recalled) and ``restitution`` e (default 0.8: lubricated
+steel teeth, recalled): ``--joint elbow:backlash_arcmin=5,mesh_stiffness=3e4,restitution=0.7``;
+``--backlash-stop recipe`` keeps MuJoCo's default limit instead. Every --joint then names
+backlash, and the play, numerics and sizing options do not apply.
 """
 
 from __future__ import annotations
@@ -45,10 +49,15 @@ JOINT_KEYS = {
     "eccentricity_x_mm": "",
     "eccentricity_y_mm": "",
     "backlash_arcmin": "",
+    "mesh_stiffness": "",
 }
 """Per-joint keys of ``--joint NAME:key=value,...`` -> the option they override ('': none; the
 journal's start in its bearing frame, [mm], defaults to the centre; ``backlash_arcmin`` gives
-the hinge gear backlash of that half-width instead of radial play)."""
+the hinge gear backlash of that half-width instead of radial play, with its stop's
+``mesh_stiffness`` [N m/rad] and ``restitution``)."""
+
+BACKLASH_KEYS = ("backlash_arcmin", "mesh_stiffness", "restitution")
+"""The keys a --joint with backlash takes."""
 
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
@@ -155,6 +164,15 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--sizing-duration-s", type=positive(float, "--sizing-duration-s"), default=1.0, help="[s] (default 1)"
     )
     p.add_argument("--no-speed", action="store_true", help="do not measure the speed cost")
+    p.add_argument(
+        "--backlash-stop",
+        default="calibrated",
+        choices=("calibrated", "recipe"),
+        help="the stop at the ends of a backlash band: calibrated (default: fitted to the gear mesh's impact law, "
+        "mesh_stiffness default 1e4 N m/rad and restitution 0.8, both recalled typical values; the time step is "
+        "lowered where the stop needs it) or recipe (MuJoCo's two hinges and a limit at its default solref and "
+        "solimp, the model's time step)",
+    )
     p.set_defaults(run_command=command)
 
 
@@ -243,11 +261,17 @@ def backlash_from_args(args: argparse.Namespace) -> dict[str, Backlash]:
             play keys too, a half-width outside (0, 600] arc-minutes (10 degrees), a joint named twice.
     """
     from clearance.retrofit import MAX_BACKLASH, Backlash
+    from clearance.retrofit.play import DEFAULT_MESH_RESTITUTION, DEFAULT_MESH_STIFFNESS
 
     cap = math.degrees(MAX_BACKLASH) * 60
     given = [
         (text, {item.partition("=")[0].strip() for item in text.partition(":")[2].split(",")}) for text in args.joint
     ]
+    for text, keys in given:
+        if "mesh_stiffness" in keys and "backlash_arcmin" not in keys:
+            raise ValueError(
+                f"--joint {text!r}: mesh_stiffness is the stop of a backlash band; give backlash_arcmin too"
+            )
     with_backlash = [(text, keys) for text, keys in given if "backlash_arcmin" in keys]
     if not with_backlash:
         return {}
@@ -260,7 +284,7 @@ def backlash_from_args(args: argparse.Namespace) -> dict[str, Backlash]:
     out: dict[str, Backlash] = {}
     for text, keys in with_backlash:
         name, v = _joint_values(args, text)
-        extra = sorted(keys - {"backlash_arcmin"})
+        extra = sorted(keys - set(BACKLASH_KEYS))
         if extra:
             raise ValueError(
                 f"--joint {text!r}: a hinge with backlash takes no radial play keys (got {', '.join(extra)}); "
@@ -271,7 +295,13 @@ def backlash_from_args(args: argparse.Namespace) -> dict[str, Backlash]:
         b = v["backlash_arcmin"]
         if not 0 < b <= cap:
             raise ValueError(f"--joint {text!r}: backlash_arcmin must be in (0, {cap:g}] (got {b:g})")
-        out[name] = Backlash.from_arcmin(b)
+        stiffness = v["mesh_stiffness"] if "mesh_stiffness" in keys else DEFAULT_MESH_STIFFNESS
+        if not stiffness > 0:
+            raise ValueError(f"--joint {text!r}: mesh_stiffness must be > 0 [N m/rad] (got {stiffness:g})")
+        e = v["restitution"] if "restitution" in keys else DEFAULT_MESH_RESTITUTION
+        if not 0 < e <= 1:
+            raise ValueError(f"--joint {text!r}: restitution must be in (0, 1] (got {e:g})")
+        out[name] = Backlash.from_arcmin(b, mesh_stiffness=stiffness, restitution=e, stop=args.backlash_stop)
     return out
 
 
@@ -288,6 +318,8 @@ def _backlash_command(args: argparse.Namespace, joints: dict[str, Backlash]) -> 
         except ValueError as err:
             raise ValueError(f"{args.model}: {err}") from None
         line = ["clearance retrofit", args.model, *[f"--joint {j}" for j in args.joint], f"--out {args.out}"]
+        if args.backlash_stop != "calibrated":
+            line.append(f"--backlash-stop {args.backlash_stop}")
         paths = write_backlash(
             result, out, source_dir=Path(args.model).resolve().parent, source=str(args.model), command=" ".join(line)
         )

@@ -10,7 +10,6 @@ reported as done.
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 
@@ -18,7 +17,8 @@ import mujoco
 
 from clearance.results import atomic_write_text
 from clearance.retrofit.assets import relocate_assets
-from clearance.retrofit.backlash import MOTOR_MASS, BacklashRetrofit
+from clearance.retrofit.backlash import BacklashRetrofit
+from clearance.retrofit.backlash_report import backlash_report
 from clearance.retrofit.manifest import MANIFEST_FILE, BacklashRecord, HingeRecord, RetrofitManifest
 from clearance.retrofit.pipeline import Retrofit
 from clearance.retrofit.report import retrofit_report
@@ -122,28 +122,7 @@ def write_backlash(
     changes = _write_models(result.spec, result.twin_spec, src, out, paths)
     paths["manifest"] = out / MANIFEST_FILE
     atomic_write_text(paths["manifest"], backlash_manifest_of(result).to_json())
-    lines = ["# Backlash retrofit", ""]
-    if source:
-        lines.append(f"Model: `{source}`" + (f"; command: `{command}`" if command else ""))
-        lines.append("")
-    lines += [
-        "Each hinge keeps its name, body, sensors, limits and keyframe values (the load side, the link). A motor "
-        "body beside it on the same axis takes its actuators, its armature and its damping; the load may turn within "
-        "+-b of the motor, by the limit of a fixed tendon q_load - q_motor at MuJoCo's default stop (not "
-        "calibrated). Keyframes start each band centred.",
-        "",
-        "| hinge | b [arcmin] | motor hinge | motor body | dead-band tendon | actuators moved | motor armature "
-        "[kg m^2] |",
-        "|---|---|---|---|---|---|---|",
-    ]
-    for h in result.hinges.values():
-        lines.append(
-            f"| {h.name} | {math.degrees(h.backlash.half_width) * 60:.4g} | {h.motor_joint} | {h.motor_body} | "
-            f"{h.tendon} | {', '.join(h.actuators)} | {h.motor_armature:.4g} ({h.armature_source}) |"
-        )
-    lines += ["", f"Keyframes extended: {result.keyframes}. Each motor body's mass: {MOTOR_MASS:g} kg."]
-    lines += [f"- asset path: {c}" for c in changes]
-    atomic_write_text(paths["report"], "\n".join(lines) + "\n")
+    atomic_write_text(paths["report"], backlash_report(result, source=source, command=command, changes=changes))
     return paths
 
 
