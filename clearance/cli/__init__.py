@@ -7,6 +7,7 @@
     clearance calibrate  fit contact parameters to LN impacts and write a report
     clearance sweep      bifurcation diagram over clearance or drive speed (resumable)
     clearance rank       joint criticality ranking (resumable)
+    clearance allocate   cheapest clearance per joint within an output budget (resumable)
     clearance bench      speed against error of MuJoCo settings (resumable)
     clearance retrofit   give hinges of any MuJoCo model radial clearance (ring bearings)
 
@@ -42,6 +43,11 @@ _OWN_PARSER = {
         "bifurcation diagram over clearance or drive speed (resumable sweep)",
     ),
     "rank": ("clearance.cli.rank", "main_rank", "joint criticality ranking (resumable sweep)"),
+    "allocate": (
+        "clearance.cli.allocate",
+        "main_allocate",
+        "cheapest clearance per joint whose output deviation stays within a budget (resumable)",
+    ),
     "bench": (
         "clearance.cli.bench",
         "main_bench",
