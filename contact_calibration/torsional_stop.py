@@ -185,16 +185,22 @@ def stop_speeds(speed: float, n: int = 5) -> np.ndarray:
     return np.geomspace(v / math.sqrt(10.0), v * math.sqrt(10.0), n)
 
 
-def stop_timestep(law: MeshLaw, inertia: float, timestep: float) -> float:
+def stop_timestep(law: MeshLaw, inertia: float, timestep: float, top_speed: float) -> float:
     """The time step [s] for the stop: ``timestep``, or below it where ω h > `OMEGA_H`.
 
-    The lowered step is OMEGA_H/ω rounded down to one significant digit.
+    ω = `laws.mesh_omega` at the law's largest penetration at ``top_speed`` [rad/s] (the
+    stiffest point of K δⁿ for n >= 1; any point for the gear mesh's n = 1). The lowered step is
+    OMEGA_H/ω rounded down to one significant digit.
 
     Raises:
         StopStabilityError: the step needed is below `MIN_TIMESTEP`.
+        ValueError: n < 1 (the stop's stiffness would be unbounded at first touch).
     """
     h = positive("timestep", timestep, "s")
-    omega = laws.mesh_omega(law.stiffness, 1e-3, inertia, law.exponent)  # δ only matters for n != 1
+    if law.exponent < 1:
+        raise ValueError(f"mesh exponent must be >= 1 (got {law.exponent!r}): K d^n is infinitely stiff at d = 0 below")
+    deepest = 1.0 if law.exponent == 1 else law_stop_impact(law, inertia, top_speed)[3]
+    omega = laws.mesh_omega(law.stiffness, deepest, inertia, law.exponent)
     if omega * h <= OMEGA_H:
         return h
     need = OMEGA_H / omega
@@ -256,8 +262,9 @@ def scene_stop_impact(model: mujoco.MjModel, speed: float, phase: float, max_ste
     raise RuntimeError(f"the stop scene did not separate within {max_steps} steps at {speed:g} rad/s")
 
 
-def law_stop_impact(law: MeshLaw, inertia: float, speed: float) -> tuple[float, float, float]:
-    """(peak torque [N m], restitution [-], duration [s]) of the law's impact at ``speed`` [rad/s]."""
+def law_stop_impact(law: MeshLaw, inertia: float, speed: float) -> tuple[float, float, float, float]:
+    """(peak torque [N m], restitution [-], duration [s], largest penetration [rad]) of the law's impact
+    at ``speed`` [rad/s]."""
     from clearance.contact_calibration.impact import simulate_impact  # scipy.integrate: on first use
 
     k, e, n = law.stiffness, law.restitution, law.exponent
@@ -266,7 +273,7 @@ def law_stop_impact(law: MeshLaw, inertia: float, speed: float) -> tuple[float, 
         return laws.mesh_torque(d, dd, v, stiffness=k, restitution=e, exponent=n)
 
     imp = simulate_impact(torque, mass=inertia, speed=speed, n_samples=200)
-    return imp.peak_force, imp.restitution, imp.duration
+    return imp.peak_force, imp.restitution, imp.duration, imp.max_penetration
 
 
 def fit_stop(

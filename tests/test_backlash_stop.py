@@ -68,6 +68,9 @@ def test_flywheel_stop_follows_the_mesh_law_over_a_decade_of_speeds(stiffness, r
     m = out.model
     stop = out.hinges["shaft"].stop
     assert stop.inertia == pytest.approx(J_EFF, rel=1e-9)  # the mass matrix's inverse along the band: rounding
+    # the speed fitted around: the motor (armature only) crossing 2b from rest under the drive's 1 N m
+    assert stop.impact_speed == pytest.approx(math.sqrt(2 * (2 * B) * 1.0 / ARMATURE), rel=1e-9)  # rounding
+    assert stop.fit is not None and stop.fit.speeds[-1] / stop.fit.speeds[0] == pytest.approx(10.0, rel=1e-12)
     # the step is lowered to omega*h <= OMEGA_H with omega = sqrt(K/J) (rounded down to one digit)
     assert m.opt.timestep * math.sqrt(stiffness / J_EFF) <= OMEGA_H
     for v in SPEEDS:
@@ -113,6 +116,7 @@ def test_a_stop_too_stiff_for_any_step_is_refused():
         ({"mesh_stiffness": -1.0}, "mesh_stiffness"),
         ({"mesh_stiffness": math.nan}, "mesh_stiffness"),
         ({"stop": "soft"}, "stop must be one of"),
+        ({"mesh_exponent": 0.5}, "mesh_exponent must be >= 1"),
     ],
 )
 def test_bad_stops_are_refused(kw, expected):

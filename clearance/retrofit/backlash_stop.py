@@ -103,7 +103,11 @@ def band_inertia(model: mujoco.MjModel, band: Band) -> float:
 
 
 def _actuator_torque(model: mujoco.MjModel, k: int) -> float | None:
-    """Largest torque actuator ``k`` applies on its joint [N m]; None where unbounded or not a plain gain."""
+    """Largest torque actuator ``k`` applies on its joint [N m]; None where unbounded.
+
+    Its force range where it has one, else its fixed gain times its largest control (a motor) or
+    its control range's span (a servo, whose bias subtracts the position: its largest error).
+    """
     gear = abs(float(model.actuator_gear[k, 0]))
     force = math.inf
     if model.actuator_forcelimited[k]:
@@ -113,9 +117,10 @@ def _actuator_torque(model: mujoco.MjModel, k: int) -> float | None:
         and int(model.actuator_gaintype[k]) == int(mujoco.mjtGain.mjGAIN_FIXED)
         and int(model.actuator_dyntype[k]) == int(mujoco.mjtDyn.mjDYN_NONE)
     ):
-        force = min(
-            force, abs(float(model.actuator_gainprm[k, 0])) * float(np.max(np.abs(model.actuator_ctrlrange[k])))
-        )
+        lo, hi = (float(x) for x in model.actuator_ctrlrange[k])
+        # a motor: gain x the largest control; a servo (a bias): gain x the control range's span, its largest error
+        servo = int(model.actuator_biastype[k]) != int(mujoco.mjtBias.mjBIAS_NONE)
+        force = min(force, abs(float(model.actuator_gainprm[k, 0])) * (hi - lo if servo else max(abs(lo), abs(hi))))
     return gear * force if math.isfinite(force) else None
 
 
@@ -146,13 +151,15 @@ def calibrate_stops(model: mujoco.MjModel, bands: Mapping[str, Band]) -> tuple[f
         for name, b in bands.items()
     }
     inertia = {name: band_inertia(model, b) for name, b in bands.items()}
+    speeds = {name: impact_speed(model, b) for name, b in bands.items()}
     step = float(model.opt.timestep)
     for name, b in bands.items():
         if b.backlash.stop == "calibrated":
-            step = min(step, stop_timestep(laws[name], inertia[name], float(model.opt.timestep)))
+            top = float(stop_speeds(speeds[name][0])[-1])
+            step = min(step, stop_timestep(laws[name], inertia[name], float(model.opt.timestep), top))
     out: dict[str, BandStop] = {}
     for name, b in bands.items():
-        speed, source = impact_speed(model, b)
+        speed, source = speeds[name]
         invweight = float(model.tendon_invweight0[b.tendon])
         if b.backlash.stop != "calibrated":
             out[name] = BandStop("recipe", inertia[name], invweight, speed, source, None, None, None)

@@ -157,7 +157,7 @@ class Backlash:
             hinge's inertia at the model's reference pose.
         mesh_stiffness: K [N m/rad^n], > 0 (`DEFAULT_MESH_STIFFNESS`, 1e4 N m/rad).
         restitution: cₑ [-], in (0, 1] (`DEFAULT_MESH_RESTITUTION`, 0.8).
-        mesh_exponent: n [-], > 0 (1: a gear mesh is a linear spring).
+        mesh_exponent: n [-], >= 1 (1: a gear mesh is a linear spring).
         impact_speed: the closing speed the stop is fitted around [rad/s] (a decade about it);
             None: estimated from the model (`clearance.retrofit.backlash.impact_speed`).
         stop: one of `STOPS` ('calibrated' unless 'recipe' is asked for).
@@ -180,7 +180,11 @@ class Backlash:
         if self.motor_armature is not None:
             positive("motor_armature", self.motor_armature, "kg m^2")
         positive("mesh_stiffness", self.mesh_stiffness, "N m/rad")
-        positive("mesh_exponent", self.mesh_exponent, "")
+        if not finite("mesh_exponent", self.mesh_exponent) >= 1:
+            raise RetrofitError(
+                f"backlash mesh_exponent must be >= 1 (got {self.mesh_exponent!r}): below 1 the stop K d^n is "
+                "infinitely stiff at first touch"
+            )
         e = finite("restitution", self.restitution)
         if not 0 < e <= 1:
             raise RetrofitError(f"backlash restitution must be in (0, 1] (got {self.restitution!r})")
