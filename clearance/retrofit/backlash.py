@@ -307,7 +307,8 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     if timestep < twin.opt.timestep:
         notes.append(
             f"time step lowered from {twin.opt.timestep:g} s to {timestep:g} s for the calibrated stops "
-            f"(omega*h <= {OMEGA_H:g} with omega = sqrt(K/J)); run the twin at this step to compare"
+            f"(omega*h <= {OMEGA_H:g} with omega = sqrt(K/J) at the lightest pose sampled); run the twin at this step "
+            "to compare"
         )
     return BacklashRetrofit(work, model, twin_spec, twin, done, nkeys, notes, timestep)
 

@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 from clearance.contact_calibration.torsional_stop import GOAL, OMEGA_H, STOP_IMPEDANCE
 from clearance.retrofit.backlash import MOTOR_MASS, BacklashHinge, BacklashRetrofit
+from clearance.retrofit.backlash_stop import POSE_SAMPLES
 from clearance.retrofit.play import DEFAULT_MESH_RESTITUTION, DEFAULT_MESH_STIFFNESS
 
 __all__ = ["backlash_report"]
@@ -81,6 +82,17 @@ def _accuracy(h: BacklashHinge) -> list[str]:
             f"| {r.speed:.4g} | {r.law_peak_torque:.5g} | {r.peak_torque:.5g} | {100 * r.peak_torque_err:+.2f} % | "
             f"{r.law_restitution:.4f} | {r.restitution:.4f} | {100 * r.restitution_err:+.2f} % |"
         )
+    if len(h.stop.pose_rows) == 2:
+        (light, heavy), (lo, hi) = h.stop.pose_rows, h.stop.inertia_range
+        lines += [
+            "",
+            f"Over {POSE_SAMPLES} poses drawn in the joints' ranges the inertia along the band runs from {lo:.4g} to "
+            f"{hi:.4g} kg m^2. The stop is the same spring and damper at every pose, and a linear damper's rebound "
+            f"changes with the inertia where the law's does not: at {light.speed:.3g} rad/s, peak torque "
+            f"{100 * light.peak_torque_err:+.1f} % and restitution {100 * light.restitution_err:+.1f} % at the "
+            f"lightest pose, {100 * heavy.peak_torque_err:+.1f} % and {100 * heavy.restitution_err:+.1f} % at the "
+            "heaviest.",
+        ]
     return lines
 
 
@@ -119,7 +131,8 @@ def backlash_report(
         f"(-spring A, -damper A with A the tendon's inverse weight) at a constant impedance {STOP_IMPEDANCE:g} "
         "(solimplimit), so the limit is a penalty spring-damper whatever the pose. The impact speed is estimated "
         "as the speed at which the motor, pushed from rest by its actuators' largest torque, takes up the whole "
-        f"band. The time step keeps omega h <= {OMEGA_H:g} with omega = sqrt(K/J). A recipe stop is MuJoCo's "
+        f"band. The time step keeps omega h <= {OMEGA_H:g} with omega = sqrt(K/J) at the lightest pose sampled. "
+        "A recipe stop is MuJoCo's "
         "default limit (solref 0.02 1, solimp 0.9 0.95 0.001) at the model's own step: the two hinges and a limit "
         "as users write them, not calibrated.",
         "",

@@ -6,7 +6,9 @@ model with its motor bodies added:
 - the effective inertia along the band, J = 1/(J_t M⁻¹ J_tᵀ) with the tendon's Jacobian J_t and
   the mass matrix M at the model's reference pose (qpos0): the link's inertia and the motor's
   armature (the rotor's reflected inertia) in series, with whatever the rest of the model
-  couples to them;
+  couples to them; and its range over `POSE_SAMPLES` poses drawn in the joints' ranges (the
+  time step is chosen at the lightest, and the fitted stop is checked against the law at the
+  lightest and the heaviest);
 - the closing speed the stop is fitted around, unless given: the speed at which the motor,
   pushed from rest by its actuators' largest torque, takes up the whole band 2b while the load
   stands, v = sqrt(2 · 2b · a) with a the band's acceleration per that torque (M⁻¹ along the
@@ -29,8 +31,10 @@ import numpy as np
 
 from clearance.contact_calibration.torsional_stop import (
     MeshLaw,
+    StopRow,
     TorsionalStop,
     fit_stop,
+    stop_at,
     stop_solimp,
     stop_solref,
     stop_speeds,
@@ -38,10 +42,24 @@ from clearance.contact_calibration.torsional_stop import (
 )
 from clearance.retrofit.play import Backlash
 
-__all__ = ["FALLBACK_IMPACT_SPEED", "Band", "BandStop", "band_inertia", "calibrate_stops", "impact_speed"]
+__all__ = [
+    "FALLBACK_IMPACT_SPEED",
+    "POSE_SAMPLES",
+    "Band",
+    "BandStop",
+    "band_inertia",
+    "calibrate_stops",
+    "impact_speed",
+    "pose_inertias",
+]
 
 FALLBACK_IMPACT_SPEED = 1.0
 """Closing speed [rad/s] a stop is fitted around where the actuators' torque is unbounded."""
+
+POSE_SAMPLES = 64
+"""Poses (besides qpos0) the effective inertia along each band is sampled at: every hinge and
+slide uniform in its range (an unlimited hinge over a turn; free, ball and unlimited slide
+joints at qpos0), each motor at its load's angle; seeded, so a retrofit is reproducible."""
 
 
 @dataclass(frozen=True)
@@ -73,6 +91,9 @@ class BandStop:
         fit: the fitted stop (None for 'recipe').
         solref: solreflimit emitted (None: MuJoCo's default).
         solimp: solimplimit emitted (None: MuJoCo's default).
+        inertia_range: (lightest, heaviest) effective inertia over the sampled poses [kg m^2].
+        pose_rows: the fitted stop against the law at the impact speed at the lightest and the
+            heaviest pose (empty for 'recipe').
     """
 
     kind: str
@@ -83,6 +104,8 @@ class BandStop:
     fit: TorsionalStop | None
     solref: tuple[float, float] | None
     solimp: tuple[float, float, float, float, float] | None
+    inertia_range: tuple[float, float] = (0.0, 0.0)
+    pose_rows: tuple[StopRow, ...] = ()
 
 
 def _inverse_mass_along(model: mujoco.MjModel, band: Band) -> np.ndarray:
@@ -94,6 +117,40 @@ def _inverse_mass_along(model: mujoco.MjModel, band: Band) -> np.ndarray:
     out = np.zeros(model.nv)
     mujoco.mj_solveM(model, data, out.reshape(1, -1), jac.reshape(1, -1))
     return out
+
+
+def pose_inertias(model: mujoco.MjModel, bands: Mapping[str, Band]) -> dict[str, tuple[float, float]]:
+    """Hinge -> (lightest, heaviest) effective inertia along its band over qpos0 and `POSE_SAMPLES` poses."""
+    rng = np.random.default_rng(0)
+    data = mujoco.MjData(model)
+    motors = [
+        (int(model.jnt_qposadr[model.dof_jntid[b.load_dof]]), int(model.jnt_qposadr[model.dof_jntid[b.motor_dof]]))
+        for b in bands.values()
+    ]
+    jacs = []
+    for b in bands.values():
+        jac = np.zeros(model.nv)
+        jac[b.load_dof], jac[b.motor_dof] = 1.0, -1.0
+        jacs.append(jac)
+    seen = np.zeros((POSE_SAMPLES + 1, len(jacs)))
+    x = np.zeros((1, model.nv))
+    for i in range(POSE_SAMPLES + 1):
+        data.qpos[:] = model.qpos0
+        for j in range(model.njnt if i else 0):
+            kind = int(model.jnt_type[j])
+            if kind not in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
+                continue
+            if model.jnt_limited[j]:
+                data.qpos[model.jnt_qposadr[j]] = rng.uniform(*model.jnt_range[j])
+            elif kind == int(mujoco.mjtJoint.mjJNT_HINGE):
+                data.qpos[model.jnt_qposadr[j]] = rng.uniform(-math.pi, math.pi)
+        for load, motor in motors:
+            data.qpos[motor] = data.qpos[load]
+        mujoco.mj_forward(model, data)
+        for k, jac in enumerate(jacs):
+            mujoco.mj_solveM(model, data, x, jac.reshape(1, -1))
+            seen[i, k] = 1.0 / float(jac @ x[0])
+    return {name: (float(seen[:, k].min()), float(seen[:, k].max())) for k, name in enumerate(bands)}
 
 
 def band_inertia(model: mujoco.MjModel, band: Band) -> float:
@@ -151,18 +208,19 @@ def calibrate_stops(model: mujoco.MjModel, bands: Mapping[str, Band]) -> tuple[f
         for name, b in bands.items()
     }
     inertia = {name: band_inertia(model, b) for name, b in bands.items()}
+    ranges = pose_inertias(model, bands)
     speeds = {name: impact_speed(model, b) for name, b in bands.items()}
     step = float(model.opt.timestep)
     for name, b in bands.items():
         if b.backlash.stop == "calibrated":
             top = float(stop_speeds(speeds[name][0])[-1])
-            step = min(step, stop_timestep(laws[name], inertia[name], float(model.opt.timestep), top))
+            step = min(step, stop_timestep(laws[name], ranges[name][0], float(model.opt.timestep), top))
     out: dict[str, BandStop] = {}
     for name, b in bands.items():
         speed, source = speeds[name]
         invweight = float(model.tendon_invweight0[b.tendon])
         if b.backlash.stop != "calibrated":
-            out[name] = BandStop("recipe", inertia[name], invweight, speed, source, None, None, None)
+            out[name] = BandStop("recipe", inertia[name], invweight, speed, source, None, None, None, ranges[name])
             continue
         fit = fit_stop(
             laws[name],
@@ -173,5 +231,8 @@ def calibrate_stops(model: mujoco.MjModel, bands: Mapping[str, Band]) -> tuple[f
             integrator=int(model.opt.integrator),
         )
         solref = stop_solref(fit.stiffness, fit.damping, invweight)
-        out[name] = BandStop("calibrated", inertia[name], invweight, speed, source, fit, solref, stop_solimp())
+        poses = tuple(stop_at(fit, j, speed) for j in ranges[name])
+        out[name] = BandStop(
+            "calibrated", inertia[name], invweight, speed, source, fit, solref, stop_solimp(), ranges[name], poses
+        )
     return step, out
