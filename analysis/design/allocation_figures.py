@@ -5,11 +5,22 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.axes import Axes
+from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
 
 from clearance.analysis.design.allocation import Allocation
 from clearance.analysis.figures.canvas import new_figure, save_png
 
 __all__ = ["plot_allocation", "plot_front", "plot_surrogate", "plot_verification"]
+
+
+def _plain_log(ax: Axes, *, x: bool = False, y: bool = True) -> None:
+    """Log axes labelled with plain numbers at 1, 2 and 5 of each decade."""
+    for on, axis in ((x, ax.xaxis), (y, ax.yaxis)):
+        if on:
+            axis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+            axis.set_major_formatter(FormatStrFormatter("%g"))
+            axis.set_minor_formatter(NullFormatter())
 
 
 def plot_allocation(a: Allocation, path: str | Path, *, unit: str, scale: float) -> None:
@@ -27,6 +38,7 @@ def plot_allocation(a: Allocation, path: str | Path, *, unit: str, scale: float)
         ax.plot(x, np.asarray(a.equal.clearances) * 1e3, "s", ms=7, mfc="none", color="C3",
                 label=f"equal clearance (cost {a.equal.cost:.4g})")  # fmt: skip
     ax.set_yscale("log")
+    _plain_log(ax)
     ax.set_xticks(x, list(p.joints))
     ax.set_xlabel("joint")
     ax.set_ylabel("radial clearance [mm]")
@@ -46,16 +58,20 @@ def plot_front(a: Allocation, path: str | Path, *, unit: str, scale: float) -> N
             continue
         b = np.array([x for x, _ in pts])
         cost = np.array([d.cost for _, d in pts])
-        ax.plot(b, cost, "-", color=colour, marker=marker, mfc="none", label=f"{label} (surrogate optimum)")
+        verified = np.array([d.mean[0] * scale for _, d in pts])
+        ax.plot(b, cost, "-", color=colour, lw=1, label=f"{label}: cost against the budget it was solved for")
         met = np.array([d.meets for _, d in pts])
-        ax.plot(b[met], cost[met], marker, color=colour, ls="none",
-                label=f"{label}: verified, >= {a.problem.target_share:.0%} within budget")  # fmt: skip
+        ax.plot(verified[met], cost[met], marker, color=colour, ls="none",
+                label=f"{label}: verified mean, >= {a.problem.target_share:.0%} of runs within budget")  # fmt: skip
+        ax.plot(verified[~met], cost[~met], marker, color=colour, mfc="none", ls="none",
+                label=f"{label}: verified mean, fewer within budget")  # fmt: skip
     ax.axvline(a.budgets[0] * scale, color="0.4", ls="--", lw=1, label="the budget")
     ax.set_xscale("log")
     ax.set_yscale("log")
-    ax.set_xlabel(f"budget of the {a.problem.measure.replace('_', ' ')} [{unit}]")
+    _plain_log(ax, x=True, y=True)
+    ax.set_xlabel(f"budget, or verified mean, of the {a.problem.measure.replace('_', ' ')} [{unit}]")
     ax.set_ylabel("cost  sum(a + b / c[mm])")
-    ax.set_title("cost against budget (open: verification below target)")
+    ax.set_title(f"cost against budget (front designs verified with {a.settings.front_runs} runs)")
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7)
     save_png(fig, path)
@@ -93,10 +109,12 @@ def plot_surrogate(a: Allocation, path: str | Path, *, unit: str, scale: float) 
     pred = s.predict(np.asarray(s.points)) * scale
     fig = new_figure(5.5, 5)
     ax = fig.add_subplot()
+    fig.subplots_adjust(left=0.17, bottom=0.12)
     ax.loglog(y, pred, "o", mfc="none", color="C0", label="design and verification points")
     lim = [min(y.min(), pred.min()) * 0.9, max(y.max(), pred.max()) * 1.1]
     ax.plot(lim, lim, "k-", lw=1, label="equal")
     fit, loo = s.relative_error
+    _plain_log(ax, x=True, y=True)
     ax.set_xlabel(f"simulated {a.problem.measure.replace('_', ' ')} [{unit}]")
     ax.set_ylabel(f"response surface [{unit}]")
     ax.set_title(f"surrogate fit: RMS error {fit:.1%} (leave-one-out {loo:.1%})")
