@@ -192,6 +192,7 @@ def test_cli_takes_the_mesh_and_the_recipe_and_reports_the_stop_against_the_law(
         ("joint0:backlash_arcmin=5,mesh_stiffness=0", "mesh_stiffness must be > 0"),
         ("joint0:backlash_arcmin=5,restitution=1.5", "restitution must be in (0, 1]"),
         ("joint0:mesh_stiffness=1e4", "give backlash_arcmin too"),
+        ("joint0:backlash_arcmin=5,mesh_stiffness=1e12", "give a smaller mesh_stiffness"),
     ],
 )
 def test_cli_refuses_a_bad_mesh_before_any_work(tmp_path, capsys, joint, expected):
