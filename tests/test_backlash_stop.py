@@ -159,6 +159,8 @@ def test_reacher_runs_one_second_with_calibrated_stops_at_both_hinges():
     m = out.model
     elbow, widest, warnings = _run(m, 1.0, "joint1", [m.tendon(h.tendon).id for h in out.hinges.values()])
     twin = out.twin
+    motor, load = m.joint("joint1__motor").id, twin.joint("joint1").id
+    assert m.jnt_limited[motor] and m.jnt_range[motor].tolist() == twin.jnt_range[load].tolist()  # the limit copied
     twin.opt.timestep = m.opt.timestep
     twin_elbow, _, twin_warnings = _run(twin, 1.0, "joint1", [])
     assert warnings == 0 and twin_warnings == 0
