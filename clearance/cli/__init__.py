@@ -8,6 +8,7 @@
     clearance sweep      bifurcation diagram over clearance or drive speed (resumable)
     clearance rank       joint criticality ranking (resumable)
     clearance allocate   cheapest clearance per joint within an output budget (resumable)
+    clearance optimise   design variables sized for the behaviour with clearance (resumable)
     clearance bench      speed against error of MuJoCo settings (resumable)
     clearance retrofit   give hinges of any MuJoCo model radial clearance (ring bearings)
 
@@ -47,6 +48,11 @@ _OWN_PARSER = {
         "clearance.cli.allocate",
         "main_allocate",
         "cheapest clearance per joint whose output deviation stays within a budget (resumable)",
+    ),
+    "optimise": (
+        "clearance.cli.optimise",
+        "main_optimise",
+        "size design variables for the lowest deviation or bearing force with clearance (resumable)",
     ),
     "bench": (
         "clearance.cli.bench",
