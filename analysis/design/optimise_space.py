@@ -25,7 +25,7 @@ from typing import Any
 
 import numpy as np
 
-from clearance.model import Mechanism
+from clearance.model import Mechanism, OutputKind
 
 __all__ = [
     "DesignFactory",
@@ -170,12 +170,13 @@ class StrokeLimits:
         if self.low is not None and self.high is not None and not self.low < self.high:
             raise ValueError(f"contradictory stroke limits: low {self.low:g} must be below high {self.high:g}")
 
-    def violation(self, stroke: float) -> str:
-        """'' when ``stroke`` is within the limits, else why not."""
+    def violation(self, stroke: float, *, angular: bool = False) -> str:
+        """'' when ``stroke`` is within the limits, else why not (in mm, or deg for an angle)."""
+        unit, f = ("deg", 180.0 / math.pi) if angular else ("mm", 1e3)
         if self.low is not None and stroke < self.low:
-            return f"stroke {stroke:.4g} below its lower limit {self.low:.4g}"
+            return f"stroke {stroke * f:.4g} {unit} below its lower limit {self.low * f:.4g} {unit}"
         if self.high is not None and stroke > self.high:
-            return f"stroke {stroke:.4g} above its upper limit {self.high:.4g}"
+            return f"stroke {stroke * f:.4g} {unit} above its upper limit {self.high * f:.4g} {unit}"
         return ""
 
 
@@ -225,10 +226,12 @@ def check_design(
         kin = solve_kinematics(mech, np.linspace(0.0, period, samples))
     except (AssemblyError, ValueError, ArithmeticError) as err:
         return Feasibility(False, f"does not assemble over its cycle: {err}", math.nan)
-    name = output or mech.outputs[0].name
-    y = kin.outputs[name]
+    out = next((o for o in mech.outputs if o.name == output), None) if output else mech.outputs[0]
+    if out is None:
+        raise ValueError(f"output {output!r} is not an output of mechanism '{mech.name}'")
+    y = kin.outputs[out.name]
     travel = float(np.max(y) - np.min(y))
-    why = stroke.violation(travel) if stroke is not None else ""
+    why = stroke.violation(travel, angular=out.kind is OutputKind.ANGLE) if stroke is not None else ""
     return Feasibility(not why, why, travel)
 
 
