@@ -34,6 +34,7 @@ FAST_GUARDS = {
     "clearance.analysis.sweeps.criticality.run_criticality": "run_criticality",
     "clearance.contact_calibration.store.calibrate_joint": "calibrate_joint",
     "clearance.retrofit.retrofit": "retrofit",
+    "clearance.analysis.sweeps.robot_ranking.run_robot_ranking": "run_robot_ranking",
 }
 """Everything that does work, by dotted path: a refused command must reach none of it."""
 
@@ -269,6 +270,24 @@ BATTERY: list[tuple[str, list[str], list[str]]] = [
     ("rank-rpm-above-cap", ["rank", "--rpm", "1000", "1e9"], ["--rpm", RPM_CAP]),
     ("rank-stop-after-negative", ["rank", "--stop-after", "-1"], ["--stop-after", "> 0"]),
     ("rank-mechanism-unknown", ["rank", "--mechanism", "nosuch"], ["--mechanism", "invalid choice"]),
+    # a robot's ranking (clearance rank --model)
+    ("rank-model-missing", ["rank", "--model", "{tmp}/none.xml"], ["--model", "none.xml does not exist"]),
+    ("rank-model-joint-unknown", ["rank", "--model", "{tmp}/arm.xml", "--joints", "nosuch"], ["--joints", "'nosuch'"]),
+    (
+        "rank-model-amplitude-above-1",
+        ["rank", "--model", "{tmp}/arm.xml", "--amplitudes", "2"],
+        ["--amplitudes", "at most 1"],
+    ),
+    (
+        "rank-model-too-few-periods",
+        ["rank", "--model", "{tmp}/arm.xml", "--frequencies-hz", "1"],
+        ["--frequencies-hz", "whole period"],
+    ),
+    (
+        "rank-model-out-is-a-file",
+        ["rank", "--model", "{tmp}/arm.xml", "--out", "{file}"],
+        ["--out {file}", "is a file"],
+    ),
     # the benchmark
     ("bench-workers-0", ["bench", "--workers", "0"], ["--workers must be >= 1"]),
     ("bench-scenario-unknown", ["bench", "--scenarios", "nosuch"], ["unknown scenario", "slider_crank"]),

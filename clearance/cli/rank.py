@@ -51,6 +51,13 @@ def rank_parser() -> argparse.ArgumentParser:
         default=6,
         help="drive periods per run, at least 3 (default 6; the first is skipped)",
     )
+    p.add_argument(
+        "--model",
+        metavar="MODEL.xml",
+        default=None,
+        help="rank the hinges of a MuJoCo model (a robot) by what radial play or backlash at each costs its end "
+        "effector, instead of a catalogue mechanism's joints (see clearance rank --model M --help)",
+    )
     add_sweep_args(p, "rank")
     return p
 
@@ -61,6 +68,10 @@ def main_rank(argv: Sequence[str] | None = None) -> int:
     Exit codes: 0 every point ran, 1 a point failed (the ranking, if any, uses the others),
     2 a usage error, 130 interrupted (Ctrl-C; the finished points are kept).
     """
+    if argv is not None and any(a == "--model" or a.startswith("--model=") for a in argv):
+        from clearance.cli.rank_model import main_rank_model
+
+        return main_rank_model(argv)
     args = rank_parser().parse_args(argv)
     try:
         out = check_folder(sweep_out(args, "rank"))

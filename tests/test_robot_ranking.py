@@ -1,0 +1,184 @@
+"""Ranking a robot's hinges by what their play costs the end effector: ``clearance rank --model``.
+
+gymnasium's reacher, both hinges, radial play (polymer bushing, exact contact) and backlash
+(5'), one grid cell (amplitude 0.5, 10 Hz), 0.4 s per run scored after 0.1 s: 4 runs.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+from gym_assets import gym_model
+
+from clearance.analysis.sweeps.robot_ranking import check_grid, per_period_deviation, rank_plays
+from clearance.cli import main
+from clearance.model import Clearance, Material
+from clearance.retrofit import Backlash, RadialPlay
+from clearance.run.play_candidates import PlayAtHinge, actuated_hinges, end_effector
+
+TINY = ["--amplitudes", "0.5", "--frequencies-hz", "10", "--duration-ms", "400", "--startup-ms", "100"]
+POLYMER = ["--youngs-modulus-gpa", "3"]
+
+
+def _cli(argv, capsys):
+    try:
+        code = main(argv)
+    except SystemExit as stop:
+        code = stop.code
+    cap = capsys.readouterr()
+    return code, cap.out, cap.err
+
+
+@pytest.fixture(scope="module")
+def ranked(tmp_path_factory):
+    """The tiny ranking of the reacher, run once by the command."""
+    out = tmp_path_factory.mktemp("rank") / "reacher"
+    argv = ["rank", "--model", str(gym_model("reacher")), *TINY, *POLYMER, "--workers", "2", "--no-progress"]
+    code = main([*argv, "--out", str(out)])
+    return out, argv, code
+
+
+def _rows(out):
+    return [json.loads(p.read_text()) for p in sorted((out / "points").glob("point_*.json"))]
+
+
+def test_the_reacher_is_ranked_with_both_plays_at_both_hinges(ranked):
+    out, _, code = ranked
+    assert code == 0
+    rows = _rows(out)
+    assert sorted((r["point"]["joint"], r["point"]["play"]) for r in rows) == sorted(
+        (j, p) for j in ("joint0", "joint1") for p in ("radial", "backlash")
+    )
+    assert all(r["status"] == "ok" for r in rows)
+    # 0.3 s after the start-up window at 10 Hz: 3 whole periods, whatever step each retrofit chose
+    assert all(len(r["per_period_mean_deviation"]) == 3 for r in rows)
+    text = (out / "ranking.md").read_text()
+    for heading in ("All candidates", "Radial play (c = 0.1 mm)", "Backlash play (b = 5 arcmin)", "Per cell"):
+        assert heading in text
+    assert (out / "ranking.png").stat().st_size > 0
+
+
+def test_a_score_is_the_end_effectors_mean_distance_from_the_twin(ranked):
+    """One point run again in this process gives the row's per-period means: the score is what it says."""
+    out, _, _ = ranked
+    row = next(r for r in _rows(out) if r["point"]["joint"] == "joint1" and r["point"]["play"] == "radial")
+    material = Material(3e9, 0.3)
+    runner = PlayAtHinge(
+        str(gym_model("reacher")),
+        "fingertip",
+        0.4,
+        RadialPlay(Clearance(1e-4, 0.01, bearing_material=material, journal_material=material)),
+        Backlash.from_arcmin(5),
+    )
+    result, twin = runner(row["point"])
+    values = per_period_deviation(result, twin, "fingertip", 10.0, 0.1)
+    # the same deterministic runs in another process: equal up to the JSON's round trip of floats
+    np.testing.assert_allclose(values, row["per_period_mean_deviation"], rtol=1e-12)
+    distance = np.hypot(
+        result.outputs["site/fingertip/x"] - twin.outputs["site/fingertip/x"],
+        result.outputs["site/fingertip/y"] - twin.outputs["site/fingertip/y"],
+    )
+    first = (result.times >= 0.1) & (result.times < 0.1 + 1 / 10 - 1e-9)
+    # the first period's mean from the two runs' positions directly: rounding of the sum only
+    assert values[0] == pytest.approx(distance[first].mean(), rel=1e-9)
+
+
+def test_the_ranking_is_rank_joints_over_the_rows(ranked):
+    out, _, _ = ranked
+    ranking = rank_plays(_rows(out), site="fingertip", startup=0.1)
+    for kind, size in (("radial", 1e-4), ("backlash", math.radians(5 / 60))):
+        r = ranking.by_kind[kind]
+        assert [s.joint for s in r.scores] == sorted(
+            ("joint0", "joint1"), key=lambda j: -next(c.mean_deviation for c in r.cells if c.joint == j)
+        )
+        for s in r.scores:  # one cell: the score is its mean deviation over the play, rounding only
+            cell = next(c for c in r.cells if c.joint == s.joint)
+            assert s.score == pytest.approx(cell.mean_deviation / size, rel=1e-12)
+            assert s.ci_low <= s.score <= s.ci_high
+    assert len(ranking.overall.scores) == 4
+
+
+def test_rerunning_the_command_resumes_without_running_again(ranked, capsys):
+    out, argv, _ = ranked
+    before = {p.name: p.read_text() for p in (out / "points").glob("point_*.json")}
+    table = (out / "ranking.md").read_text()
+    code, _, err = _cli([*argv, "--out", str(out)], capsys)
+    assert code == 0, err
+    assert {p.name: p.read_text() for p in (out / "points").glob("point_*.json")} == before  # no point ran again
+    assert (out / "ranking.md").read_text() == table
+    code, _, err = _cli([*argv, "--backlash-arcmin", "6", "--out", str(out)], capsys)
+    assert code == 2 and "holds a different ranking" in err
+
+
+def test_defaults_pick_the_actuated_hinges_and_the_deepest_body():
+    import mujoco
+
+    model = mujoco.MjModel.from_xml_path(str(gym_model("pusher")))
+    hinges = actuated_hinges(model)
+    assert len(hinges) == 7 and hinges[0] == "r_shoulder_pan_joint"
+    assert end_effector(model, hinges) == "tips_arm"
+
+
+IDLE = """<mujoco><worldbody><body name="a"><joint name="shoulder" axis="0 0 1"/>
+<geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01"/>
+<body name="b" pos="0.2 0 0"><joint name="free_pin" axis="0 0 1"/>
+<geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01"/></body></body></worldbody>
+<actuator><motor joint="shoulder"/></actuator></mujoco>"""
+"""A two-link arm whose elbow ``free_pin`` has no actuator."""
+
+
+@pytest.mark.parametrize(
+    ("extra", "expected"),
+    [
+        (["--joints", "free_pin"], "--joints: joint 'free_pin' of"),
+        (["--joints", "nosuch"], "is not a joint"),
+        (["--joints", "shoulder", "shoulder"], "names 'shoulder' twice"),
+        (["--site", "nowhere"], "--site 'nowhere' is neither a site nor a body"),
+        (["--frequencies-hz", "1"], "hold 0 whole period(s) of 1 s; the score needs at least 2"),
+        (["--startup-ms", "2000"], "shorter than the run"),
+        (["--amplitudes", "1.5"], "--amplitudes must be at most 1"),
+        (["--frequencies-hz", "0"], "--frequencies-hz must be > 0"),
+        (["--backlash-arcmin", "700"], "--backlash-arcmin must be at most 600"),
+    ],
+)
+def test_bad_input_is_refused_before_any_work(tmp_path, capsys, monkeypatch, extra, expected):
+    """One error line naming the option, exit 2, and no folder: nothing ran."""
+    import clearance.analysis.sweeps.robot_ranking as rr
+
+    monkeypatch.setattr(rr, "run_robot_ranking", lambda *a, **k: pytest.fail("the ranking ran"))
+    model = tmp_path / "arm.xml"
+    model.write_text(IDLE)
+    out = tmp_path / "out"
+    code, _, err = _cli(["rank", "--model", str(model), "--out", str(out), "--duration-ms", "1000", *extra], capsys)
+    assert code == 2, err
+    lines = [ln for ln in err.splitlines() if ln.strip()]
+    assert len(lines) == 1 or "usage:" in lines[0], err
+    assert expected in err
+    assert not out.exists()
+
+
+def test_unactuated_hinge_is_refused_only_for_backlash(capsys, tmp_path):
+    model = tmp_path / "arm.xml"
+    model.write_text(IDLE)
+    argv = [
+        "rank",
+        "--model",
+        str(model),
+        "--joints",
+        "free_pin",
+        "--duration-ms",
+        "1000",
+        "--out",
+        str(tmp_path / "o"),
+    ]
+    code, _, err = _cli(argv, capsys)
+    assert code == 2 and "no actuator on it" in err and "rank it with radial play alone" in err
+
+
+def test_grid_check_counts_whole_periods_after_the_start_up_window():
+    check_grid([0.5], [2.0], 1.25, 0.25)  # exactly 2 periods of 0.5 s: accepted
+    with pytest.raises(ValueError, match="hold 1 whole period"):
+        check_grid([0.5], [2.0], 1.2, 0.25)
