@@ -168,6 +168,16 @@ def test_optimisation_pipeline_finds_confirms_and_resumes(tmp_path):
     again = run()
     assert not _EVALUATED  # every run was read back from the store
     assert again.optimum == first.optimum and again.confirmation == first.confirmation
+    # an optimisation stopped part-way kept only some runs: drop a third of them, as a stop would have
+    files = sorted((tmp_path / "runs").iterdir())
+    for f in files[::3]:
+        f.unlink()
+    _EVALUATED.clear()
+    resumed = run()
+    assert len(_EVALUATED) == len(files[::3])  # only the missing runs ran again
+    assert resumed.optimum == first.optimum and resumed.search.trials == first.search.trials
+    for a, b in ((resumed.confirmation.start, c.start), (resumed.confirmation.optimum, c.optimum)):
+        assert (a.value, a.se) == (b.value, b.se)  # the runs are deterministic: equal (only wall times differ)
 
 
 # --- the command ---------------------------------------------------------------------------
