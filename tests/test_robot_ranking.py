@@ -182,3 +182,35 @@ def test_grid_check_counts_whole_periods_after_the_start_up_window():
     check_grid([0.5], [2.0], 1.25, 0.25)  # exactly 2 periods of 0.5 s: accepted
     with pytest.raises(ValueError, match="hold 1 whole period"):
         check_grid([0.5], [2.0], 1.2, 0.25)
+
+
+def test_dask_runs_the_ranking_as_the_process_pool_does(ranked, tmp_path):
+    """The same points through a Dask scheduler give the same rows (deterministic runs)."""
+    from clearance.analysis.sweeps.robot_ranking import play_points, run_robot_ranking
+
+    distributed = pytest.importorskip("dask.distributed")
+    out, _, _ = ranked
+    runner = PlayAtHinge(
+        str(gym_model("reacher")),
+        "fingertip",
+        0.4,
+        RadialPlay(Clearance(1e-4, 0.01, bearing_material=Material(3e9, 0.3), journal_material=Material(3e9, 0.3))),
+        Backlash.from_arcmin(5),
+    )
+    points = play_points(["joint0", "joint1"], {"backlash": math.radians(5 / 60)}, [0.5], [10.0])
+    with distributed.LocalCluster(n_workers=1, processes=False, dashboard_address=None) as cluster:
+        ranking = run_robot_ranking(
+            runner,
+            points,
+            site="fingertip",
+            startup=0.1,
+            out_dir=tmp_path,
+            scheduler_address=cluster.scheduler_address,
+            progress=False,
+        )
+    pool = {r["point"]["joint"]: r for r in _rows(out) if r["point"]["play"] == "backlash"}
+    for row in _rows(tmp_path):
+        assert row["per_period_mean_deviation"] == pool[row["point"]["joint"]]["per_period_mean_deviation"]
+    assert [s.joint for s in ranking.by_kind["backlash"].scores] == [
+        s.joint for s in rank_plays(_rows(out), site="fingertip", startup=0.1).by_kind["backlash"].scores
+    ]
