@@ -469,6 +469,9 @@ def allocate(
             c_ref = np.full(len(p.joints), p.budget_reference)
             ref = runner.verify(c_ref, [math.inf] * len(p.operating_points), nruns)
             budgets = ref.mean
+            # its share within the budget it sets (about half its runs, by construction)
+            share = tuple(sum(v <= b for v in vals) / ref.runs for vals, b in zip(ref.values, budgets, strict=True))
+            ref = replace(ref, share=share, meets=all(x >= p.target_share for x in share))
         else:
             budgets = tuple(float(b) for b in p.budgets)
         low = runner.verify(lo, budgets, nruns)

@@ -87,15 +87,15 @@ def plot_verification(a: Allocation, path: str | Path, *, unit: str, scale: floa
     fig = new_figure(max(6.0, 0.9 * len(designs) + 2), 4.5)
     ax = fig.add_subplot()
     rng = np.random.default_rng(0)  # horizontal jitter of the points only
-    for i, (_, d) in enumerate(designs):
+    for i, (name, d) in enumerate(designs):
         v = np.asarray(d.values[0]) * scale
-        colour = "C2" if d.meets else "C3"
+        colour = "0.5" if name == "reference" else "C2" if d.meets else "C3"
         ax.plot(i + 0.15 * rng.uniform(-1, 1, len(v)), v, ".", color=colour, alpha=0.7)
         ax.errorbar(i + 0.3, d.mean[0] * scale, yerr=d.std[0] * scale, fmt="_", color="k", capsize=3)
     ax.axhline(a.budgets[0] * scale, color="0.3", ls="--", lw=1, label="budget")
     ax.set_xticks(range(len(designs)), [n for n, _ in designs], rotation=30, ha="right", fontsize=8)
     ax.set_ylabel(f"{a.problem.measure.replace('_', ' ')} [{unit}]")
-    ax.set_title("verification ensembles (green: target share met; bar: mean ± scatter)")
+    ax.set_title("verification ensembles: green meets the target share, red not, grey sets the budget", fontsize=9)
     ax.grid(alpha=0.3, axis="y")
     ax.legend(fontsize=8)
     fig.subplots_adjust(bottom=0.25)
