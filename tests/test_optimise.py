@@ -268,13 +268,13 @@ def test_scenario_section_sets_the_optimisation(tmp_path):
     path.write_text(_SCENARIO)
     args = optimise_parser().parse_args(["--scenario", str(path), "--runs", "4", "--out", str(tmp_path / "o")])
     plan = _plan(args)
-    assert [v.name for v in plan["variables"]] == ["slider_mass", "crank_length"]
-    assert plan["variables"][1].low == pytest.approx(0.045, rel=1e-12)  # 45 mm in m, to rounding
-    assert plan["start"] == {"slider_mass": 0.14, "crank_length": pytest.approx(0.05, rel=1e-12)}
-    assert plan["ensemble"].runs == 4  # the command line wins over the file's 3
+    assert [v.name for v in plan.variables] == ["slider_mass", "crank_length"]
+    assert plan.variables[1].low == pytest.approx(0.045, rel=1e-12)  # 45 mm in m, to rounding
+    assert plan.start == {"slider_mass": 0.14, "crank_length": pytest.approx(0.05, rel=1e-12)}
+    assert plan.ensemble.runs == 4  # the command line wins over the file's 3
     assert args.objective == "peak_force" and args.budget == 12 and args.samples == 8  # file, file, default
-    assert plan["factory"].fixed["radial_clearance"] == pytest.approx(1e-4, rel=1e-12)
-    assert plan["stroke"].low == pytest.approx(0.095, rel=1e-12)
+    assert plan.factory.fixed["radial_clearance"] == pytest.approx(1e-4, rel=1e-12)
+    assert plan.stroke.low == pytest.approx(0.095, rel=1e-12)
 
 
 @pytest.mark.parametrize(

@@ -28,14 +28,21 @@ import shlex
 import sys
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, NoReturn
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from clearance.cli.arg_types import bounded, positive, rpm_option, timestep_option
 from clearance.cli.optimise_scenario import ScenarioDesign, read_scenario_design, section_vary
 from clearance.cli.options import CONTACT_MODES, DEFAULT_MECHANISM, check_clearance_at, contact_mode_from_args, si
 from clearance.cli.sweep_common import INTERRUPTED, UsageError, catalogue_entry, usage_error
 from clearance.units import UNITS, quantity_of
+
+if TYPE_CHECKING:  # the analysis is imported when the command runs, not when it is parsed
+    from clearance.analysis.design.ensemble import EnsembleSettings
+    from clearance.analysis.design.optimise import OptimisationResult
+    from clearance.analysis.design.optimise_search import SearchSettings
+    from clearance.analysis.design.optimise_space import DesignFactory, DesignVariable, StrokeLimits
 
 __all__ = ["main_optimise", "optimise_parser", "parse_variable"]
 
@@ -239,8 +246,37 @@ def main_optimise(argv: Sequence[str] | None = None) -> int:
     except (UsageError, ValueError) as err:
         return usage_error(str(err))
     except KeyboardInterrupt:
-        print(f"interrupted; the finished runs are kept in {plan['out'] / 'runs'}, rerun to resume", file=sys.stderr)
+        print(f"interrupted; the finished runs are kept in {plan.out / 'runs'}, rerun to resume", file=sys.stderr)
         return INTERRUPTED
+
+
+@dataclass(frozen=True)
+class _Plan:
+    """Everything a checked command line asks for, in SI.
+
+    Attributes:
+        out: the output folder.
+        factory: design point -> mechanism.
+        variables: the design variables with their bounds.
+        start: the start design (variable -> value).
+        conditions: operating conditions (drive speeds) the objective is averaged over.
+        output: the output measured.
+        angular: the output is an angle.
+        stroke: limits of its stroke, or None.
+        ensemble: the ensembles' settings.
+        search: the search's settings.
+    """
+
+    out: Path
+    factory: DesignFactory
+    variables: tuple[DesignVariable, ...]
+    start: dict[str, float]
+    conditions: list[dict[str, Any]]
+    output: str
+    angular: bool
+    stroke: StrokeLimits | None
+    ensemble: EnsembleSettings
+    search: SearchSettings
 
 
 _SETTINGS: dict[str, tuple[Callable[[str], Any], Any]] = {
@@ -311,7 +347,7 @@ def _source(args: argparse.Namespace) -> ScenarioDesign | None:
     return design
 
 
-def _plan(args: argparse.Namespace) -> dict[str, Any]:
+def _plan(args: argparse.Namespace) -> _Plan:
     """Every input checked, before any work: factory, variables, settings (or UsageError)."""
     from clearance.analysis.design.ensemble import EnsembleSettings
     from clearance.analysis.design.optimise_search import SearchSettings
@@ -399,20 +435,18 @@ def _plan(args: argparse.Namespace) -> dict[str, Any]:
     if not first.feasible:
         scan_bounds(factory, variables, output=output, stroke=stroke)  # refuses bounds where nothing is feasible
         raise UsageError(f"--vary: the start design {_design(x0)} is infeasible: {first.reason}; give START values")
-    return {
-        "out": out,
-        "factory": factory,
-        "variables": variables,
-        "start": x0,
-        "conditions": conditions,
-        "output": output,
-        "angular": angular,
-        "stroke": stroke,
-        "ensemble": EnsembleSettings(
-            runs=args.runs, seed=args.seed, periods=args.periods, output=output, options=options
-        ),
-        "search": SearchSettings(samples=args.samples, budget=args.budget, seed=args.seed),
-    }
+    return _Plan(
+        out,
+        factory,
+        variables,
+        x0,
+        conditions,
+        output,
+        angular,
+        stroke,
+        EnsembleSettings(runs=args.runs, seed=args.seed, periods=args.periods, output=output, options=options),
+        SearchSettings(samples=args.samples, budget=args.budget, seed=args.seed),
+    )
 
 
 def _shown(name: str) -> tuple[str, float]:
@@ -429,7 +463,7 @@ def _design(point: dict[str, float]) -> str:
     )
 
 
-def _optimise(args: argparse.Namespace, plan: dict[str, Any]) -> int:
+def _optimise(args: argparse.Namespace, plan: _Plan) -> int:
     """The optimisation of a checked plan, its confirmation and its report; the exit status."""
     from clearance.analysis.design.optimise import optimise_design
     from clearance.analysis.design.optimise_figure import plot_convergence
@@ -437,8 +471,8 @@ def _optimise(args: argparse.Namespace, plan: dict[str, Any]) -> int:
     from clearance.analysis.sweeps.executor import SchedulerError
     from clearance.cli.paths import folder_lock
 
-    out: Path = plan["out"]
-    scale, unit = (1e6, "µrad") if plan["angular"] and args.objective != "peak_force" else (1e6, "µm")
+    out: Path = plan.out
+    scale, unit = (1e6, "µrad") if plan.angular and args.objective != "peak_force" else (1e6, "µm")
     if args.objective == "peak_force":
         scale, unit = 1.0, "N"
     t0 = time.perf_counter()
@@ -459,21 +493,21 @@ def _optimise(args: argparse.Namespace, plan: dict[str, Any]) -> int:
         print(f"  design {count[0]}: {shown}: {what} ({time.perf_counter() - t0:.0f} s)", flush=True)
 
     print(
-        f"optimise {args.mechanism}: {len(plan['variables'])} variables, {args.objective}, ensembles of "
+        f"optimise {args.mechanism}: {len(plan.variables)} variables, {args.objective}, ensembles of "
         f"{args.runs} runs x {args.periods} periods, at most {args.budget} designs; runs kept in {out / 'runs'}",
         flush=True,
     )
     try:
         with folder_lock(out):
             result = optimise_design(
-                plan["factory"],
-                plan["variables"],
+                plan.factory,
+                plan.variables,
                 measure=args.objective,
-                ensemble=plan["ensemble"],
-                search=plan["search"],
-                conditions=plan["conditions"],
-                stroke=plan["stroke"],
-                start=plan["start"],
+                ensemble=plan.ensemble,
+                search=plan.search,
+                conditions=plan.conditions,
+                stroke=plan.stroke,
+                start=plan.start,
                 confirm_seed=args.confirm_seed,
                 store=out / "runs",
                 scheduler_address=args.scheduler,
@@ -489,7 +523,7 @@ def _optimise(args: argparse.Namespace, plan: dict[str, Any]) -> int:
             reports = _design_runs(plan, result, out)
             print(f"run reports in {time.perf_counter() - t0 - search_s:.1f} s", flush=True)
             plot_convergence(result, out / "convergence.png", scale=scale, unit=unit)
-            stroke_scale, stroke_unit = (180 / math.pi, "deg") if plan["angular"] else (1e3, "mm")
+            stroke_scale, stroke_unit = (180 / math.pi, "deg") if plan.angular else (1e3, "mm")
             md = optimise_markdown(
                 result,
                 title=f"Design optimisation of {args.mechanism} with clearance",
@@ -513,17 +547,17 @@ def _optimise(args: argparse.Namespace, plan: dict[str, Any]) -> int:
     return 0
 
 
-def _design_runs(plan: dict[str, Any], result: Any, out: Path) -> list[tuple[str, str]]:
+def _design_runs(plan: _Plan, result: OptimisationResult, out: Path) -> list[tuple[str, str]]:
     """One run of the start design and of the optimum, written as ``clearance run`` writes them."""
     from clearance.cli.outputs import write_outputs
     from clearance.run.simulation import simulate
 
     reports = []
     ns = argparse.Namespace(rerun=None)
-    settings = plan["ensemble"]
+    settings = plan.ensemble
     for label, point in (("start", result.start), ("optimum", result.optimum)):
-        mech = plan["factory"]({**point, **plan["conditions"][0]})
-        duration = settings.periods * mech.drive_period
+        mech = plan.factory({**point, **plan.conditions[0]})
+        duration = settings.periods * (mech.drive_period or 0.0)  # every design has one (checked up front)
         run = simulate(mech, duration=duration, options=settings.options)
         ideal = simulate(mech.ideal_twin(), duration=duration, options=settings.options)
         print(f"{label} design, one run with the journals centred:")
