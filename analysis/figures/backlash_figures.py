@@ -68,7 +68,13 @@ def plot_backlash(result: SimulationResult, summary: BacklashSummary, *, path: s
 
 
 def backlash_section(out: str | Path, result: SimulationResult, rows: list[BacklashSummary]) -> list[str]:
-    """The report's lines on the backlashed hinges, with their figures written into ``out`` ([] for none)."""
+    """The report's lines on the backlashed hinges, with their figures written into ``out`` ([] for none).
+
+    Args:
+        out: the run's folder (exists).
+        result: the run with the backlash outputs.
+        rows: each hinge's `BacklashSummary` (`backlash_summaries`).
+    """
     if not rows:
         return []
     lines = [

@@ -73,6 +73,12 @@ _MANIFEST = "robot_ranking.json"
 def check_grid(amplitudes: Sequence[float], frequencies: Sequence[float], duration: float, startup: float) -> None:
     """Refuse a grid a ranking cannot score (before any work).
 
+    Args:
+        amplitudes: fractions of each actuator's control half-range.
+        frequencies: sinusoid frequencies [Hz].
+        duration: simulated time of each run [s].
+        startup: start-up window the score skips [s].
+
     Raises:
         ValueError: an empty grid, an amplitude outside (0, 1] (a fraction of each actuator's
             control half-range), a frequency not finite and > 0, a start-up window not shorter
@@ -123,6 +129,13 @@ def per_period_deviation(
 ) -> np.ndarray:
     """Mean distance [m] of ``site`` from the twin's over each whole period of ``frequency`` after ``startup``.
 
+    Args:
+        result: the run with play (the site's outputs ``site/<name>/x|y|z``).
+        twin: the unmodified twin's run.
+        site: the site (or body).
+        frequency: the control frequency [Hz]; one period is 1 / frequency.
+        startup: start-up window skipped [s].
+
     Raises:
         ValueError: fewer than one whole period after the start-up window.
     """
@@ -145,6 +158,13 @@ def evaluate_play_point(
     index: int, point: Mapping[str, Any], runner: PlayRunner, site: str, startup: float
 ) -> dict[str, Any]:
     """Run one point and score it (in a worker); a point that fails gives a row with status ``error``.
+
+    Args:
+        index: the point's index.
+        point: ``{"joint", "play", "size", "amplitude", "frequency"}``.
+        runner: point -> (run, twin run).
+        site: the end effector.
+        startup: start-up window the score skips [s].
 
     Returns:
         ``{"index", "point", "status", "error", "per_period_mean_deviation" [m] (list),
@@ -191,6 +211,11 @@ class RobotRanking:
 
 def rank_plays(rows: Sequence[Mapping[str, Any]], *, site: str, startup: float) -> RobotRanking:
     """Rank the rows of a robot ranking (see the module docstring).
+
+    Args:
+        rows: the rows of `evaluate_play_point` (``load_rows`` of a ranking's folder).
+        site: the end effector, recorded in the ranking.
+        startup: the start-up window [s], recorded in the ranking.
 
     Raises:
         NothingToRankError: no point ran (a `ValueError`).
