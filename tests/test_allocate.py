@@ -272,3 +272,20 @@ def test_several_speeds_each_meet_their_budget(tmp_path):
     # the binding speed sits at its budget up to the surrogate's fit error (< 3 % on a 2-joint linear form)
     assert 0.97 * 6e-4 <= d.mean[1] <= 6e-4
     assert d.mean[1] == pytest.approx(2 * float(np.array([3.0, 1.0]) @ c), rel=1e-12)
+
+
+def test_factories_set_each_joint_and_the_speed():
+    from clearance.analysis.design.factories import FixedMechanism
+    from clearance.model import Clearance
+
+    base = FixedMechanism(watt_six_bar(clearance_at=("A",), radial_clearance=2e-4))
+    make = JointClearances(base, template=Clearance(radial_clearance=1e-4, friction=0.1))
+    m = make({"clearances": {"A": 5e-5, "D": 7e-5}, "speed": 50.0})
+    assert m.drives[0].speed == 50.0
+    a, d = m.joint("A").require_clearance(), m.joint("D").require_clearance()
+    assert a.radial_clearance == 5e-5 and a.friction == 0.0  # A keeps its own record, new clearance
+    assert d.radial_clearance == 7e-5 and d.friction == 0.1  # D was ideal: the template's record
+    with pytest.raises(KeyError, match="Q"):
+        make({"clearances": {"Q": 1e-4}})
+    with pytest.raises(ValueError, match="only 'speed'"):
+        base({"crank_speed": 1.0})
