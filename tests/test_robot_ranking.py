@@ -214,3 +214,46 @@ def test_dask_runs_the_ranking_as_the_process_pool_does(ranked, tmp_path):
     assert [s.joint for s in ranking.by_kind["backlash"].scores] == [
         s.joint for s in rank_plays(_rows(out), site="fingertip", startup=0.1).by_kind["backlash"].scores
     ]
+
+
+def _run(times, x):
+    from clearance.results import SimulationResult
+
+    n = len(times)
+    return SimulationResult(
+        times=times,
+        outputs={"site/tip/x": x, "site/tip/y": np.sin(times), "site/tip/z": np.zeros(n)},
+        joints={},
+        drive_angle=np.zeros((n, 0)),
+        drive_speed=np.zeros((n, 0)),
+        drive_torque=np.zeros((n, 0)),
+        link_poses=np.zeros((n, 0, 3)),
+        closure_violation=np.zeros(n),
+        metadata={"timestep": 1e-3},
+    )
+
+
+def _half_broken(point):
+    """Runs of joint1 fail; joint0's end effector sits ``size`` x 10 off the twin's in x throughout."""
+    if point["joint"] == "joint1":
+        raise RuntimeError("this hinge cannot be retrofitted")
+    t = np.arange(400) * 1e-3
+    return _run(t, np.cos(t) + 10 * point["size"]), _run(t, np.cos(t))
+
+
+def test_a_failed_run_is_a_row_and_the_ranking_uses_the_others(tmp_path):
+    from concurrent.futures import ThreadPoolExecutor
+
+    from clearance.analysis.sweeps.robot_ranking import play_points, run_robot_ranking
+
+    points = play_points(["joint0", "joint1"], {"radial": 1e-4}, [0.5], [10.0])
+    with ThreadPoolExecutor(2) as pool:
+        ranking = run_robot_ranking(
+            _half_broken, points, site="tip", startup=0.1, out_dir=tmp_path, executor=pool, progress=False
+        )
+    assert [p["joint"] for p, _ in ranking.failed] == ["joint1"]
+    assert "this hinge cannot be retrofitted" in ranking.failed[0][1]
+    (score,) = ranking.by_kind["radial"].scores
+    # a constant 1 mm offset: every period's mean distance is 1 mm, the score 10 (mm per 0.1 mm), rounding only
+    assert score.joint == "joint0" and score.score == pytest.approx(10.0, rel=1e-9)
+    assert score.se < 1e-9 * score.score  # no scatter between periods but the rounding of (cos t + c') - cos t
