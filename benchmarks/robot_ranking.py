@@ -54,6 +54,7 @@ def main() -> int:
         ranking = (out / "ranking.md").read_text() if (out / "ranking.md").is_file() else "(no ranking written)\n"
         ranking = ranking.split("\n", 2)[2] if ranking.startswith("# ") else ranking
         ranking = ranking.replace("![ranking](ranking.png)", "")
+        ranking = "\n".join(ln for ln in ranking.splitlines() if not ln.startswith("`clearance rank"))  # shown above
         if (out / "ranking.png").is_file():
             (HERE / "robot_ranking.png").write_bytes((out / "ranking.png").read_bytes())
     shown = shlex.join(["clearance", *cmd[1:3], "gymnasium/envs/mujoco/assets/pusher.xml", *cmd[4:-2]])
