@@ -57,7 +57,7 @@ def rank_model_parser() -> argparse.ArgumentParser:
 
     d = DEFAULTS
     p = argparse.ArgumentParser(
-        prog="clearance rank --model", description="Rank a robot's hinges by what their play costs its end effector."
+        prog="clearance rank", description="Rank a robot's hinges by what their play costs its end effector."
     )
     p.add_argument("--model", required=True, metavar="MODEL.xml", help="the MuJoCo model (MJCF)")
     p.add_argument("--joints", nargs="+", default=None, help="candidate hinges (default: every actuated hinge)")
