@@ -80,6 +80,37 @@ def test_flywheel_edit_moves_the_armature_and_actuator_and_keeps_the_rest(flywhe
     assert key[m.joint("idle").qposadr[0]] == 0.1
 
 
+SENSED = FLYWHEEL.replace(
+    '<sensor><jointpos name="shaft_angle" joint="shaft"/></sensor>',
+    '<sensor><jointpos name="shaft_angle" joint="shaft"/><jointvel name="shaft_speed" joint="shaft"/>'
+    '<jointactuatorfrc name="shaft_torque" joint="shaft"/><jointpos name="idle_angle" joint="idle"/></sensor>',
+)
+
+
+@pytest.mark.parametrize("side", ["load", "motor"])
+def test_sensors_stay_on_the_load_side_unless_asked_and_actuator_force_follows_the_actuator(side):
+    out = add_backlash(mujoco.MjSpec.from_string(SENSED), {"shaft": Backlash(B, stop="recipe", sensors=side)})
+    m = out.model
+    on = {m.sensor(k).name: int(m.sensor_objid[k]) for k in range(m.nsensor)}
+    state = m.joint("shaft__motor").id if side == "motor" else m.joint("shaft").id
+    assert on["shaft_angle"] == state and on["shaft_speed"] == state
+    assert on["shaft_torque"] == m.joint("shaft__motor").id  # the actuator's torque acts on the motor hinge now
+    assert on["idle_angle"] == m.joint("idle").id  # another joint's sensor is untouched
+    moved = {"shaft_torque"} | ({"shaft_angle", "shaft_speed"} if side == "motor" else set())
+    assert set(out.hinges["shaft"].moved_sensors) == moved
+    d = mujoco.MjData(m)
+    d.ctrl[0] = 0.05  # N m
+    mujoco.mj_step(m, d)
+    mujoco.mj_forward(m, d)
+    torque = d.sensordata[m.sensor("shaft_torque").adr[0]]
+    assert torque == pytest.approx(0.05, rel=1e-12)  # the motor's torque, read where it acts: rounding only
+
+
+def test_bad_sensor_side_is_refused():
+    with pytest.raises(RetrofitError, match="sensors must be one of load, motor"):
+        Backlash(B, sensors="encoder")
+
+
 def test_flywheel_without_armature_gets_a_stated_fraction():
     spec = mujoco.MjSpec.from_string(FLYWHEEL.replace(' armature="0.002"', ""))
     out = add_backlash(spec, {"shaft": Backlash.from_arcmin(30)})
@@ -161,6 +192,20 @@ def test_cli_writes_the_reacher_with_backlash(tmp_path, capsys):
     report = (out / "retrofit.md").read_text()
     assert "| joint1 | 5 | joint1__motor |" in report and "| joint1 | calibrated | 10000 | 0.8 | 1 |" in report
     assert "moved to 'joint0__motor'" in stdout
+
+
+def test_cli_puts_the_sensors_on_the_motor_side_when_asked(tmp_path, capsys):
+    source = tmp_path / "flywheel.xml"
+    source.write_text(SENSED)
+    out = tmp_path / "out"
+    argv = ["retrofit", str(source), "--out", str(out), "--joint", "shaft:backlash_arcmin=30"]
+    code, stdout, err = _cli([*argv, "--backlash-stop", "recipe", "--backlash-sensors", "motor"], capsys)
+    assert code == 0, err
+    written = mujoco.MjModel.from_xml_path(str(out / "model.xml"))
+    assert written.sensor_objid[written.sensor("shaft_angle").id] == written.joint("shaft__motor").id
+    report = (out / "retrofit.md").read_text()
+    assert "| shaft_angle, shaft_speed, shaft_torque |" in report and "--backlash-sensors motor" in report
+    assert "sensors on the motor side: shaft_angle, shaft_speed, shaft_torque" in stdout
 
 
 @pytest.mark.parametrize(

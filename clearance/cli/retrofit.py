@@ -14,7 +14,8 @@ The stop at either end of the band is calibrated to the gear mesh's impact law w
 ``mesh_stiffness`` K [N m/rad] (default 1e4: a small robot gearbox's torsional stiffness, as
 strain-wave gear catalogues give it, recalled) and ``restitution`` e (default 0.8: lubricated
 steel teeth, recalled): ``--joint elbow:backlash_arcmin=5,mesh_stiffness=3e4,restitution=0.7``;
-``--backlash-stop recipe`` keeps MuJoCo's default limit instead. Every --joint then names
+``--backlash-stop recipe`` keeps MuJoCo's default limit instead; ``--backlash-sensors motor`` puts the
+hinge's jointpos and jointvel sensors on the motor side. Every --joint then names
 backlash, and the play, numerics and sizing options do not apply.
 """
 
@@ -173,6 +174,14 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "lowered where the stop needs it) or recipe (MuJoCo's two hinges and a limit at its default solref and "
         "solimp, the model's time step)",
     )
+    p.add_argument(
+        "--backlash-sensors",
+        default="load",
+        choices=("load", "motor"),
+        help="where a backlashed hinge's jointpos and jointvel sensors read: load (default: the link, the hinge's own "
+        "angle) or motor (the motor side, as an encoder on the motor); its jointactuatorfrc sensors follow the "
+        "actuators to the motor side either way",
+    )
     p.set_defaults(run_command=command)
 
 
@@ -301,7 +310,9 @@ def backlash_from_args(args: argparse.Namespace) -> dict[str, Backlash]:
         e = v["restitution"] if "restitution" in keys else DEFAULT_MESH_RESTITUTION
         if not 0 < e <= 1:
             raise ValueError(f"--joint {text!r}: restitution must be in (0, 1] (got {e:g})")
-        out[name] = Backlash.from_arcmin(b, mesh_stiffness=stiffness, restitution=e, stop=args.backlash_stop)
+        out[name] = Backlash.from_arcmin(
+            b, mesh_stiffness=stiffness, restitution=e, stop=args.backlash_stop, sensors=args.backlash_sensors
+        )
     return out
 
 
@@ -320,6 +331,8 @@ def _backlash_command(args: argparse.Namespace, joints: dict[str, Backlash]) -> 
         line = ["clearance retrofit", args.model, *[f"--joint {j}" for j in args.joint], f"--out {args.out}"]
         if args.backlash_stop != "calibrated":
             line.append(f"--backlash-stop {args.backlash_stop}")
+        if args.backlash_sensors != "load":
+            line.append(f"--backlash-sensors {args.backlash_sensors}")
         paths = write_backlash(
             result, out, source_dir=Path(args.model).resolve().parent, source=str(args.model), command=" ".join(line)
         )

@@ -57,6 +57,8 @@ MOTOR_ARMATURE_FRACTION = 0.01
 diagonal mass-matrix entry at the model's reference pose [-]."""
 
 _HINGE = mujoco.mjtJoint.mjJNT_HINGE
+_ACTUATOR_SENSORS = (mujoco.mjtSensor.mjSENS_JOINTACTFRC,)
+_STATE_SENSORS = (mujoco.mjtSensor.mjSENS_JOINTPOS, mujoco.mjtSensor.mjSENS_JOINTVEL)
 _TRN_JOINT = (int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT))
 _QPOS_WIDTH = {
     mujoco.mjtJoint.mjJNT_FREE: 7,
@@ -92,6 +94,9 @@ class BacklashHinge:
         armature_source: where it came from ('the hinge's armature (moved)', 'given', or the
             fraction of the hinge's inertia).
         stop: the stop at the ends of the band (its inertia, impact speed and fit).
+        moved_sensors: names (or ``#k``) of the hinge's sensors now on the motor side: its
+            jointactuatorfrc sensors (they follow the actuators), and its jointpos and
+            jointvel sensors where ``backlash.sensors`` is 'motor'.
     """
 
     name: str
@@ -103,6 +108,7 @@ class BacklashHinge:
     motor_armature: float
     armature_source: str
     stop: BandStop
+    moved_sensors: tuple[str, ...] = ()
 
 
 @dataclass
@@ -179,6 +185,21 @@ def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backl
     return actuated
 
 
+def _move_sensors(spec: mujoco.MjSpec, hinge: str, play: Backlash) -> tuple[str, ...]:
+    """Point the hinge's sensors that belong on the motor side at its motor hinge; their labels.
+
+    jointactuatorfrc always moves (the actuators are on the motor hinge now; on the link it
+    would read 0); jointpos and jointvel move where ``play.sensors`` is 'motor'.
+    """
+    kinds = _ACTUATOR_SENSORS + (_STATE_SENSORS if play.sensors == "motor" else ())
+    moved = []
+    for k, sensor in enumerate(spec.sensors):
+        if sensor.objtype == mujoco.mjtObj.mjOBJ_JOINT and sensor.objname == hinge and sensor.type in kinds:
+            sensor.objname = motor_joint_name(hinge)
+            moved.append(sensor.name or f"#{k}")
+    return tuple(moved)
+
+
 def _reference_inertia(twin: mujoco.MjModel, dof: int) -> float:
     """The hinge's diagonal mass-matrix entry at the reference pose [kg m^2]."""
     data = mujoco.MjData(twin)
@@ -215,6 +236,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     actuators = {int(a.id): a for a in work.actuators}
     cls = add_builtin_class(work)
     pending: dict[str, tuple[str, Backlash, str, str, str, tuple[str, ...], float, str]] = {}
+    sensors: dict[str, tuple[str, ...]] = {}
     for name, play in joints.items():
         j = mujoco.mj_name2id(twin, mujoco.mjtObj.mjOBJ_JOINT, name)
         body = int(twin.jnt_bodyid[j])
@@ -262,6 +284,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
         band.wrap_joint(motor_joint_name(name), -1.0)
         for k in actuated[name]:
             actuators[k].target = motor_joint_name(name)
+        sensors[name] = _move_sensors(work, name, play)
         pending[name] = (
             name,
             play,
@@ -290,7 +313,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
             tendon.solref_limit = list(stop.solref)
             tendon.solimp_limit = list(stop.solimp)
     work.option.timestep = timestep
-    done = {name: BacklashHinge(*pending[name], stops[name]) for name in joints}
+    done = {name: BacklashHinge(*pending[name], stops[name], sensors[name]) for name in joints}
     nkeys = _extend_keyframes(work, twin, kinematic, old_joints, done)
     model = compile_model(work)
     kept = np.array([int(bodies[b].id) for b in old_bodies])
@@ -301,7 +324,12 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     notes = [
         f"hinge '{h.name}': actuators {', '.join(h.actuators)} moved to '{h.motor_joint}' (armature "
         f"{h.motor_armature:.4g} kg m^2, {h.armature_source}); dead band +-{h.backlash.half_width:.4g} rad by the "
-        f"limit of tendon '{h.tendon}', {_stop_note(h.stop)}; sensors stay on the load side"
+        f"limit of tendon '{h.tendon}', {_stop_note(h.stop)}; "
+        + (
+            f"sensors on the motor side: {', '.join(h.moved_sensors)}"
+            if h.moved_sensors
+            else "sensors on the load side"
+        )
         for h in done.values()
     ]
     if timestep < twin.opt.timestep:

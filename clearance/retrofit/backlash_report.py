@@ -29,13 +29,14 @@ _LAW = (
 def _hinge_rows(hinges: Sequence[BacklashHinge]) -> list[str]:
     lines = [
         "| hinge | b [arcmin] | motor hinge | motor body | dead-band tendon | actuators moved | motor armature "
-        "[kg m^2] |",
-        "|---|---|---|---|---|---|---|",
+        "[kg m^2] | sensors moved to the motor side |",
+        "|---|---|---|---|---|---|---|---|",
     ]
     for h in hinges:
         lines.append(
             f"| {h.name} | {math.degrees(h.backlash.half_width) * 60:.4g} | {h.motor_joint} | {h.motor_body} | "
-            f"{h.tendon} | {', '.join(h.actuators)} | {h.motor_armature:.4g} ({h.armature_source}) |"
+            f"{h.tendon} | {', '.join(h.actuators)} | {h.motor_armature:.4g} ({h.armature_source}) | "
+            f"{', '.join(h.moved_sensors) or 'none'} |"
         )
     return lines
 
@@ -115,7 +116,9 @@ def backlash_report(
         "Each hinge keeps its name, body, sensors, limits and keyframe values (the load side, the link). A motor "
         "body beside it on the same axis takes its actuators, its armature (the rotor's reflected inertia) and its "
         "damping, and a copy of its limit; the load may turn within +-b of the motor, by the limit of a fixed tendon "
-        "q_load - q_motor. Keyframes start each band centred.",
+        "q_load - q_motor. Keyframes start each band centred. The hinge's jointactuatorfrc sensors follow its "
+        "actuators to the motor side (on the link they would read 0); its jointpos and jointvel sensors read the "
+        "link unless `--backlash-sensors motor` puts them on the motor side, as an encoder on the motor reads.",
         "",
         *_hinge_rows(hinges),
         "",

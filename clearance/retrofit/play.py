@@ -23,6 +23,7 @@ __all__ = [
     "DEFAULT_MESH_RESTITUTION",
     "DEFAULT_MESH_STIFFNESS",
     "MAX_BACKLASH",
+    "SENSOR_SIDES",
     "STOPS",
     "DEFAULT_BEARING_RADIUS",
     "DEFAULT_CLASS",
@@ -138,6 +139,11 @@ STOPS = ("calibrated", "recipe")
 `clearance.contact_calibration.torsional_stop`) or 'recipe' (the same limit at MuJoCo's
 default solref and solimp, the two-hinges-and-a-limit recipe, and the model's time step)."""
 
+SENSOR_SIDES = ("load", "motor")
+"""Where a backlashed hinge's jointpos and jointvel sensors read: 'load' (the link, the
+hinge's own angle: the default) or 'motor' (the motor side's hinge). Its jointactuatorfrc
+sensors follow the actuators to the motor side either way (on the link they would read 0)."""
+
 
 @dataclass(frozen=True)
 class Backlash:
@@ -161,6 +167,9 @@ class Backlash:
         impact_speed: the closing speed the stop is fitted around [rad/s] (a decade about it);
             None: estimated from the model (`clearance.retrofit.backlash.impact_speed`).
         stop: one of `STOPS` ('calibrated' unless 'recipe' is asked for).
+        sensors: one of `SENSOR_SIDES`: where the hinge's position and velocity sensors
+            read ('load', the default: the link's angle, as before the edit; 'motor': the
+            motor side's, as an encoder on the motor reads it).
     """
 
     half_width: float
@@ -170,6 +179,7 @@ class Backlash:
     mesh_exponent: float = 1.0
     impact_speed: float | None = None
     stop: str = "calibrated"
+    sensors: str = "load"
 
     def __post_init__(self) -> None:
         b = finite("backlash half_width", self.half_width)
@@ -192,6 +202,8 @@ class Backlash:
             positive("impact_speed", self.impact_speed, "rad/s")
         if self.stop not in STOPS:
             raise RetrofitError(f"backlash stop must be one of {', '.join(STOPS)} (got {self.stop!r})")
+        if self.sensors not in SENSOR_SIDES:
+            raise RetrofitError(f"backlash sensors must be one of {', '.join(SENSOR_SIDES)} (got {self.sensors!r})")
 
     @classmethod
     def from_arcmin(
@@ -202,10 +214,13 @@ class Backlash:
         mesh_stiffness: float = DEFAULT_MESH_STIFFNESS,
         restitution: float = DEFAULT_MESH_RESTITUTION,
         stop: str = "calibrated",
+        sensors: str = "load",
     ) -> Backlash:
         """A backlash from its half-width in arc-minutes."""
         b = math.radians(finite("backlash_arcmin", half_width_arcmin) / 60.0)
-        return cls(b, motor_armature, mesh_stiffness=mesh_stiffness, restitution=restitution, stop=stop)
+        return cls(
+            b, motor_armature, mesh_stiffness=mesh_stiffness, restitution=restitution, stop=stop, sensors=sensors
+        )
 
 
 @dataclass(frozen=True)
