@@ -38,6 +38,8 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 
 from _tables import write_keeping_reading
 
+from clearance.results import atomic_write_bytes
+
 PROBLEMS = {
     "slider_crank": [
         "--mechanism",
@@ -143,11 +145,11 @@ def _variables(d: dict) -> str:
     )
 
 
-def markdown(results: list[dict], workers: int) -> str:
+def markdown(results: list[dict], workers: int, out: Path) -> str:
     lines = [
         "# Design optimisation with clearance: slider-crank and seven-bar press",
         "",
-        "Command: `python benchmarks/optimise_designs.py --out /tmp/optimise-bench` (each problem from an empty "
+        f"Command: `python benchmarks/optimise_designs.py --out {out}` (each problem from an empty "
         f"folder, {workers} local workers).",
         f"Machine: {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}, measured "
         f"{time.strftime('%Y-%m-%d %H:%M UTC', time.gmtime())}.",
@@ -182,6 +184,8 @@ def markdown(results: list[dict], workers: int) -> str:
         )
     lines += ["", "Commands as run:", ""]
     lines += [f"- {r['name']}: `{r['command']}`" for r in results]
+    lines += [""]
+    lines += [f"![{r['name']} convergence](optimise_{r['name']}.png)\n" for r in results]
     return "\n".join(lines) + "\n"
 
 
@@ -193,8 +197,11 @@ def main() -> None:
     args = p.parse_args()
     names = [args.only] if args.only else list(PROBLEMS)
     results = [run(n, Path(args.out), args.workers) for n in names]
-    text = markdown(results, args.workers)
+    text = markdown(results, args.workers, Path(args.out))
     if args.only is None:
+        here = Path(__file__).parent
+        for n in names:  # the convergence figures beside the table
+            atomic_write_bytes(here / f"optimise_{n}.png", (Path(args.out) / n / "convergence.png").read_bytes())
         write_keeping_reading(Path(__file__).with_suffix(".md"), text)
     print(text)
 
