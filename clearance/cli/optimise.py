@@ -548,7 +548,8 @@ def _optimise(args: argparse.Namespace, plan: _Plan) -> int:
 
 
 def _design_runs(plan: _Plan, result: OptimisationResult, out: Path) -> list[tuple[str, str]]:
-    """One run of the start design and of the optimum, written as ``clearance run`` writes them."""
+    """One run of the start design and of the optimum (journals centred, at the first operating condition),
+    written into ``start/`` and ``optimum/`` as ``clearance run`` writes a run's outputs; (label, report path)."""
     from clearance.cli.outputs import write_outputs
     from clearance.run.simulation import simulate
 
