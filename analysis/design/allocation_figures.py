@@ -24,7 +24,14 @@ def _plain_log(ax: Axes, *, x: bool = False, y: bool = True) -> None:
 
 
 def plot_allocation(a: Allocation, path: str | Path, *, unit: str, scale: float) -> None:
-    """Clearance per joint: the allocation, the equal design, the bounds."""
+    """Clearance per joint: the allocation, the equal design, the bounds.
+
+    Args:
+        a: the allocation.
+        path: the PNG to write.
+        unit, scale: unused here (clearances are drawn in mm); kept so every allocation
+            figure is called alike.
+    """
     p = a.problem
     fig = new_figure(max(5.0, 1.2 * len(p.joints) + 2), 4)
     ax = fig.add_subplot()
@@ -49,7 +56,14 @@ def plot_allocation(a: Allocation, path: str | Path, *, unit: str, scale: float)
 
 
 def plot_front(a: Allocation, path: str | Path, *, unit: str, scale: float) -> None:
-    """Cost against budget: the allocation's front and the equal designs, verified points marked."""
+    """Cost against budget: the allocation's front and the equal designs, verified points marked.
+
+    Args:
+        a: the allocation.
+        path: the PNG to write.
+        unit: the output measure's unit as shown (e.g. "µrad").
+        scale: factor from the measure's SI value to ``unit``.
+    """
     fig = new_figure(6.5, 4.5)
     ax = fig.add_subplot()
     for which, colour, marker, label in (("allocated", "C0", "o", "allocation"), ("equal", "C3", "s", "equal")):
@@ -78,7 +92,14 @@ def plot_front(a: Allocation, path: str | Path, *, unit: str, scale: float) -> N
 
 
 def plot_verification(a: Allocation, path: str | Path, *, unit: str, scale: float) -> None:
-    """Per-run values of the verification ensembles against the budget (first operating point)."""
+    """Per-run values of the verification ensembles against the budget (first operating point).
+
+    Args:
+        a: the allocation.
+        path: the PNG to write.
+        unit: the output measure's unit as shown (e.g. "µrad").
+        scale: factor from the measure's SI value to ``unit``.
+    """
     designs = [(f"allocation {i + 1}", d) for i, d in enumerate(a.allocation_iterations)]
     designs += [(f"equal {i + 1}", d) for i, d in enumerate(a.equal_iterations)]
     designs.append(("lower bounds", a.lower_bound))
@@ -103,7 +124,14 @@ def plot_verification(a: Allocation, path: str | Path, *, unit: str, scale: floa
 
 
 def plot_surrogate(a: Allocation, path: str | Path, *, unit: str, scale: float) -> None:
-    """The response surface's predictions against the fitted runs (first operating point)."""
+    """The response surface's predictions against the fitted runs (first operating point).
+
+    Args:
+        a: the allocation.
+        path: the PNG to write.
+        unit: the output measure's unit as shown (e.g. "µrad").
+        scale: factor from the measure's SI value to ``unit``.
+    """
     s = a.surrogates[0]
     y = np.asarray(s.values) * scale
     pred = s.predict(np.asarray(s.points)) * scale

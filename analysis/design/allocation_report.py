@@ -247,7 +247,16 @@ def _tables(a: Allocation, scale: float) -> dict[str, str]:
 def write_allocation(
     a: Allocation, out: str | Path, *, title: str, unit: str, scale: float, command: str = ""
 ) -> list[Path]:
-    """Write the report, tables and figures into ``out`` (see the module docstring); returns the paths."""
+    """Write the report, tables and figures into ``out`` (see the module docstring); returns the paths.
+
+    Args:
+        a: the allocation.
+        out: the folder (made if missing).
+        title: the report's title line.
+        unit: the output measure's unit as shown (e.g. "µrad").
+        scale: factor from the measure's SI value to ``unit``.
+        command: the command line that made it, quoted in the report ("" for none).
+    """
     from clearance.analysis.design.allocation_figures import (
         plot_allocation,
         plot_front,

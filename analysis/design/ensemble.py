@@ -243,6 +243,11 @@ def simulated_measures(mechanism: Mechanism, start: StartState, settings: Ensemb
 
     The ideal twin is simulated once per worker and reused (`ideal_run`).
 
+    Args:
+        mechanism: the design with its clearances.
+        start: clearance joint -> its journal's start offset (e_x, e_y) [m]; empty: centred.
+        settings: periods, output, options of the run.
+
     Raises:
         ValueError: the mechanism has no drive with a set period, or not the output.
     """
@@ -468,5 +473,12 @@ def run_ensemble(
     settings: EnsembleSettings | None = None,
     **kwargs: Any,
 ) -> EnsembleResult:
-    """One design as an ensemble: `run_ensembles` with one point (same keyword arguments)."""
+    """One design as an ensemble: `run_ensembles` with one point.
+
+    Args:
+        make_mechanism: picklable factory, point -> Mechanism (as for `run_ensembles`).
+        point: the design.
+        settings: the ensemble's settings (default `EnsembleSettings()`).
+        kwargs: `run_ensembles`' keyword arguments (store, executor, progress, ...).
+    """
     return run_ensembles(make_mechanism, [point], settings, **kwargs)[0]

@@ -24,6 +24,12 @@ __all__ = ["FixedMechanism", "JointClearances", "with_clearances"]
 def with_clearances(mechanism: Mechanism, clearances: Mapping[str, float], template: Clearance) -> Mechanism:
     """The mechanism with each named joint at its own radial clearance [m].
 
+    Args:
+        mechanism: the design (not changed: a new one is returned).
+        clearances: joint name -> its radial clearance [m].
+        template: the clearance record (bearing, materials, law) of a named joint that has
+            none yet; a joint that has one keeps it and changes only its radial clearance.
+
     Raises:
         KeyError: a name that is not a joint of the mechanism.
         ValueError: a joint that is not revolute, or a clearance its bearing cannot hold.

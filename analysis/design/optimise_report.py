@@ -205,7 +205,13 @@ def optimise_json(result: OptimisationResult) -> dict[str, Any]:
 
 
 def write_optimise_report(out_dir: str | Path, result: OptimisationResult, markdown: str) -> Path:
-    """Write ``optimise.md`` and ``optimise.json`` into ``out_dir`` (atomically); the Markdown's path."""
+    """Write ``optimise.md`` and ``optimise.json`` into ``out_dir`` (atomically); the Markdown's path.
+
+    Args:
+        out_dir: the folder (it exists).
+        result: the optimisation, written as ``optimise.json``.
+        markdown: the report's text, written as ``optimise.md``.
+    """
     out = Path(out_dir)
     atomic_write_text(out / "optimise.json", json.dumps(optimise_json(result), indent=1, default=float))
     path = out / "optimise.md"

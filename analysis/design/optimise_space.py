@@ -236,7 +236,7 @@ def check_design(
 
 
 def unit_sample(count: int, dims: int, seed: int) -> np.ndarray:
-    """A Latin-hypercube sample of the unit cube, reproducible: (count, dims) in [0, 1)."""
+    """A Latin-hypercube sample of the unit cube, reproducible: (count, dims) in [0, 1) from ``seed``."""
     from scipy.stats import qmc
 
     return np.asarray(qmc.LatinHypercube(d=dims, seed=seed).random(count))
@@ -259,6 +259,14 @@ def scan_bounds(
 
     The centre of the bounds, their corners (up to 16) and a Latin-hypercube sample of
     ``count`` designs are checked with `check_design`, stopping at the first feasible one.
+
+    Args:
+        factory: picklable design point -> Mechanism.
+        variables: the design variables and their bounds.
+        output: the output whose stroke is checked (default the mechanism's first).
+        stroke: the stroke's limits (None: not checked).
+        count: size of the Latin-hypercube sample.
+        seed: the sample's seed.
 
     Returns:
         The first feasible design point found (variable -> value [SI]).

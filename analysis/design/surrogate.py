@@ -292,6 +292,12 @@ def equal_clearance(
     found by bisection in log c between max(lower) and min(upper) (or as the largest allowed
     level there that meets the budgets).
 
+    Args:
+        deviations: per operating point, clearances (n,) [m] -> predicted deviation.
+        budgets: per operating point, the budget [SI].
+        lower, upper: per joint, the clearance bounds [m].
+        levels: allowed clearances [m] (None: any value in the bounds).
+
     Returns:
         The clearance [m] (rounded down to 1 nm), or None when the bounds share no clearance
         or none of it meets the budgets.

@@ -188,6 +188,11 @@ def _builder_key(key: str, params: Sequence[str], mechanism: str) -> tuple[str, 
 def parse_variable(text: str, params: Sequence[str], mechanism: str) -> tuple[str, float, float, float | None]:
     """(variable name, low, high, start or None) in SI of one ``--vary`` value.
 
+    Args:
+        text: the option's value, ``KEY=LOW:HIGH[:START]``.
+        params: the builder's keyword names.
+        mechanism: the catalogue name, for messages.
+
     Raises:
         UsageError: a malformed value, an unknown keyword or unit, contradictory bounds.
     """
