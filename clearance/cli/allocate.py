@@ -21,10 +21,8 @@ command reuses them and gives the same allocation.
 from __future__ import annotations
 
 import argparse
-import re
 import shlex
 import sys
-import tomllib
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -32,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 from clearance.cli.arg_types import bounded, positive, rpm_option
 from clearance.cli.options import add_sweep_args, si, sweep_options
 from clearance.cli.paths import check_folder, folder_lock
+from clearance.cli.scenario_sections import split_section
 from clearance.cli.sweep_common import INTERRUPTED, UsageError, catalogue_entry, check_scheduler, probe, usage_error
 from clearance.model import JointType, Mechanism, OutputKind
 
@@ -166,30 +165,6 @@ def _run(
         raise UsageError(f"--scheduler {args.scheduler}: {err}") from None
 
 
-def _split_scenario(path: Path) -> tuple[str, dict[str, Any]]:
-    """The scenario text without its ``[allocation...]`` tables (blank lines in their place, so
-    line numbers hold), and the allocation table."""
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise ValueError(f"--scenario {path}: cannot read it ({err})") from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise ValueError(f"--scenario {path}: not valid TOML: {err}") from None
-    header = re.compile(r"^\s*\[\[?\s*([A-Za-z0-9_.\"' -]+?)\s*\]\]?\s*(#.*)?$")
-    lines, inside = [], False
-    for line in text.splitlines():
-        m = header.match(line)
-        if m:
-            inside = m.group(1).split(".")[0].strip("\"' ") == "allocation"
-        lines.append("" if inside else line)
-    table = doc.get("allocation", {})
-    if not isinstance(table, dict):
-        raise ValueError(f"--scenario {path}: [allocation] must be a table")
-    return "\n".join(lines) + "\n", table
-
-
 def _mechanism(args: argparse.Namespace) -> tuple[str, MechanismFactory, Mechanism]:
     """(name, base factory point -> Mechanism without clearances, its mechanism at the first point)."""
     from clearance.analysis.design.factories import FixedMechanism
@@ -201,7 +176,8 @@ def _mechanism(args: argparse.Namespace) -> tuple[str, MechanismFactory, Mechani
         from clearance.builders.scenario import ScenarioError, loads_scenario
 
         path = Path(args.scenario)
-        text, args.allocation_table = _split_scenario(path)
+        split = split_section(path, "allocation")
+        text, args.allocation_table = split.scenario_text, split.section
         try:
             mech = loads_scenario(text, source=str(path))
         except ScenarioError as err:

@@ -26,12 +26,11 @@ the design factory, which must rebuild exactly the mechanism the file describes.
 from __future__ import annotations
 
 import math
-import re
-import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from clearance.cli.scenario_sections import split_section
 from clearance.cli.sweep_common import UsageError
 from clearance.model import ContactLaw, Mechanism
 from clearance.units import UNITS, quantity_of
@@ -55,8 +54,6 @@ SECTION_KEYS = (
 )
 """Keys an ``[optimise]`` section may hold."""
 
-_HEADER = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
-
 
 @dataclass(frozen=True)
 class ScenarioDesign:
@@ -75,18 +72,6 @@ class ScenarioDesign:
     keywords: dict[str, Any]
     section: dict[str, Any]
     mechanism: Mechanism
-
-
-def _blank_section(text: str) -> str:
-    """The text with the lines of ``[optimise]`` and its sub-tables blanked (line numbers kept)."""
-    out, inside = [], False
-    for line in text.splitlines():
-        m = _HEADER.match(line)
-        if m:
-            name = m.group(1).strip().strip('"')
-            inside = name == "optimise" or name.startswith("optimise.")
-        out.append("" if inside else line)
-    return "\n".join(out) + "\n"
 
 
 def _keyword(key: str, params: list[str]) -> tuple[str, float]:
@@ -134,23 +119,12 @@ def read_scenario_design(path: str) -> ScenarioDesign:
     from clearance.builders.scenario import loads_scenario
 
     p = Path(path)
-    if p.is_dir():
-        raise UsageError(f"--scenario {p}: is a folder; give a scenario file (.toml)")
-    try:
-        text = p.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as err:
-        raise UsageError(f"--scenario {p}: cannot read it ({err})") from None
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise UsageError(f"--scenario {p}: not valid TOML: {err}") from None
-    section = doc.get("optimise", {})
-    if not isinstance(section, dict):
-        raise UsageError(f"--scenario {p}: [optimise] must be a table")
+    split = split_section(p, "optimise")
+    doc, section = split.document, split.section
     unknown = sorted(set(section) - set(SECTION_KEYS))
     if unknown:
         raise UsageError(f"--scenario {p}: [optimise] has unknown key(s) {unknown}; it takes {', '.join(SECTION_KEYS)}")
-    mechanism = loads_scenario(_blank_section(text), source=str(p))
+    mechanism = loads_scenario(split.scenario_text, source=str(p))
     table = doc.get("mechanism", {})
     name = table.get("builder") if isinstance(table, dict) else None
     if not isinstance(name, str) or name not in CATALOGUE:
