@@ -13,9 +13,9 @@ import math
 import mujoco
 import numpy as np
 import pytest
+from cli_runner import run_cli as _cli
 from gym_assets import gym_model
 
-from clearance.cli import main
 from clearance.retrofit import Backlash, RetrofitError
 from clearance.retrofit.backlash import MOTOR_MASS, add_backlash
 
@@ -167,12 +167,6 @@ def test_slide_is_refused():
 def test_bad_bands_are_refused(b):
     with pytest.raises(ValueError, match="half_width"):
         Backlash(b)
-
-
-def _cli(argv, capsys):
-    code = main(argv)
-    captured = capsys.readouterr()
-    return code, captured.out, captured.err
 
 
 def test_cli_writes_the_reacher_with_backlash(tmp_path, capsys):

@@ -14,6 +14,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from cli_runner import run_cli as _cli
 from gym_assets import gym_model
 
 from clearance.cli import main
@@ -383,12 +384,6 @@ def test_choose_time_step_rounds_down_to_1_2_5_and_never_exceeds_the_models():
     assert choose_time_step({"a": sizing(STEP_OMEGA_H / 9.9e-6), "b": sizing(1.0)}, 0.01) == pytest.approx(5e-6)
     assert choose_time_step({"a": sizing(STEP_OMEGA_H / 1e-5)}, 0.01) == pytest.approx(1e-5)
     assert choose_time_step({"a": sizing(1.0)}, 0.002) == 0.002
-
-
-def _cli(argv: list[str], capsys) -> tuple[int, str, str]:
-    code = main(argv)
-    out = capsys.readouterr()
-    return code, out.out, out.err
 
 
 @pytest.mark.parametrize(

@@ -12,10 +12,10 @@ import shutil
 import mujoco
 import numpy as np
 import pytest
+from cli_runner import run_cli as _cli
 from gym_assets import gym_model
 
 from clearance.analysis.metrics.site_deviation import site_deviation
-from clearance.cli import main
 from clearance.model import Material
 from clearance.results import SimulationResult
 from clearance.retrofit import RadialPlay, RetrofitError, RetrofitOptions, SineControl, retrofit, write_retrofit
@@ -40,15 +40,6 @@ def folder(tmp_path_factory):
     out = tmp_path_factory.mktemp("reacher_retrofit")
     write_retrofit(r, out, source_dir=path.parent)
     return out
-
-
-def _cli(argv, capsys):
-    try:
-        code = main(argv)
-    except SystemExit as stop:
-        code = stop.code
-    cap = capsys.readouterr()
-    return code, cap.out, cap.err
 
 
 def test_manifest_records_the_time_step_and_each_hinge(folder):

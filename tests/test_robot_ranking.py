@@ -11,6 +11,7 @@ import math
 
 import numpy as np
 import pytest
+from cli_runner import run_cli as _cli
 from gym_assets import gym_model
 
 from clearance.analysis.sweeps.robot_ranking import check_grid, per_period_deviation, rank_plays
@@ -21,15 +22,6 @@ from clearance.run.play_candidates import PlayAtHinge, actuated_hinges, end_effe
 
 TINY = ["--amplitudes", "0.5", "--frequencies-hz", "10", "--duration-ms", "400", "--startup-ms", "100"]
 POLYMER = ["--youngs-modulus-gpa", "3"]
-
-
-def _cli(argv, capsys):
-    try:
-        code = main(argv)
-    except SystemExit as stop:
-        code = stop.code
-    cap = capsys.readouterr()
-    return code, cap.out, cap.err
 
 
 @pytest.fixture(scope="module")
