@@ -106,6 +106,12 @@ def test_sensors_stay_on_the_load_side_unless_asked_and_actuator_force_follows_t
     assert torque == pytest.approx(0.05, rel=1e-12)  # the motor's torque, read where it acts: rounding only
 
 
+def test_a_model_retrofitted_already_is_refused():
+    once = add_backlash(mujoco.MjSpec.from_string(FLYWHEEL), {"shaft": Backlash(B, stop="recipe")})
+    with pytest.raises(RetrofitError, match="is it retrofitted already.*cannot be stacked"):
+        add_backlash(once.spec, {"shaft": Backlash(B, stop="recipe")})
+
+
 def test_bad_sensor_side_is_refused():
     with pytest.raises(RetrofitError, match="sensors must be one of load, motor"):
         Backlash(B, sensors="encoder")

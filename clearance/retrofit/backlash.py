@@ -37,7 +37,7 @@ from clearance.contact_calibration.torsional_stop import OMEGA_H
 from clearance.retrofit.backlash_stop import Band, BandStop, calibrate_stops
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.play import PREFIX, Backlash, RetrofitError
-from clearance.retrofit.selection import compile_model, model_label
+from clearance.retrofit.selection import check_not_retrofitted, compile_model, model_label
 
 __all__ = [
     "MOTOR_ARMATURE_FRACTION",
@@ -141,6 +141,7 @@ def _actuator_label(model: mujoco.MjModel, k: int) -> str:
 def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> dict[str, list[int]]:
     """Hinge name -> ids of the actuators on it; raises `RetrofitError` for a hinge that cannot take backlash."""
     where = model_label(spec)
+    check_not_retrofitted(spec, twin)
     actuated: dict[str, list[int]] = {}
     for name, play in joints.items():
         if not isinstance(play, Backlash):

@@ -116,6 +116,27 @@ def _prefixed_names(model: mujoco.MjModel) -> list[str]:
     return found
 
 
+def check_not_retrofitted(spec: mujoco.MjSpec, model: mujoco.MjModel) -> None:
+    """Refuse a model that already carries a retrofit (radial play or backlash).
+
+    Args:
+        spec: the model's spec (for its name and default classes).
+        model: ``spec`` compiled.
+
+    Raises:
+        RetrofitError: names with the retrofit's prefix (or its default class) are in the
+            model; the message names some of them and asks for the unmodified model.
+    """
+    clash = _prefixed_names(model) + ([DEFAULT_CLASS] if spec.find_default(DEFAULT_CLASS) is not None else [])
+    if clash:
+        some = ", ".join(sorted(set(clash))[:5])
+        raise RetrofitError(
+            f"{model_label(spec)} already has names starting with '{PREFIX}' ({some}), the "
+            "prefix of what a retrofit adds: is it retrofitted already? Retrofit the unmodified model (one "
+            "command gives one kind of play: radial play and backlash cannot be stacked)"
+        )
+
+
 def select_hinges(spec: mujoco.MjSpec, model: mujoco.MjModel, names: Sequence[str]) -> list[Hinge]:
     """Check the request and locate each hinge.
 
@@ -152,12 +173,7 @@ def select_hinges(spec: mujoco.MjSpec, model: mujoco.MjModel, names: Sequence[st
                 f'{label} disables {what}s (<option><flag {what}="disable"/>): the bearing ring is a set of '
                 "contact pairs and needs them; enable them to retrofit"
             )
-    clash = _prefixed_names(model) + ([DEFAULT_CLASS] if spec.find_default(DEFAULT_CLASS) is not None else [])
-    if clash:
-        raise RetrofitError(
-            f"{label} already has names starting with '{PREFIX}' ({', '.join(sorted(clash)[:5])}), the prefix "
-            "of what a retrofit adds: is it retrofitted already? Retrofit the unmodified model"
-        )
+    check_not_retrofitted(spec, model)
     hinges = hinge_names(model)
     out = []
     for n in names:
