@@ -34,7 +34,9 @@ The same library registers a second plugin, ``clearance.work``: a sensor that in
 work done on a model by each kind of force (actuators, equality and contact constraint rows,
 dampers, plugin passive forces), step by step, so that an energy balance closes from rollout
 sensor rows; `clearance.contact_plugin.energy.add_energy_meter` adds it with MuJoCo's kinetic
-and potential energy sensors.
+and potential energy sensors. A third, ``clearance.backlash_stop``, closes a backlash band with
+the gear mesh's impact law (`clearance.contact_calibration.laws.mesh_torque`) as passive torques
+on its two hinges; `clearance.contact_plugin.backlash_stop.add_backlash_stop` adds it.
 """
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
 // clearance.journal_bearing: exact journal-bearing contact of a revolute clearance joint.
-// (The same library also registers clearance.work, the energy meter's work sensor: see its
-// section after the journal-bearing callbacks.)
+// (The same library also registers clearance.work, the energy meter's work sensor, and
+// clearance.backlash_stop, the gear mesh's impact law at the ends of a backlash band: see their
+// sections after the journal-bearing callbacks.)
 //
 // A MuJoCo engine plugin (capabilities mjPLUGIN_PASSIVE | mjPLUGIN_SENSOR), one instance per
 // clearance joint. It needs no collision geometry: the journal and the bearing are two circles,
@@ -531,19 +532,41 @@ static void apply(const mjModel* m, mjData* d, const jbData* c, const jbEval* ev
   }
 }
 
+// The per-mjData evaluation caches of the passive plugins hold structs that begin with
+// (mjtNum time; int valid;). cache_slot picks where an evaluation at `time` goes: the slot
+// already holding that time, else a free one, else the next in round-robin order.
+typedef struct {
+  mjtNum time;
+  int valid;
+} evalHead;
+
+static int cache_slot(const void* cache, size_t stride, int n, mjtNum time, int* next) {
+  const char* base = (const char*)cache;
+  for (int i = 0; i < n; i++) {
+    const evalHead* e = (const evalHead*)(base + i * stride);
+    if (e->valid && e->time == time) return i;
+  }
+  for (int i = 0; i < n; i++) {
+    if (!((const evalHead*)(base + i * stride))->valid) return i;
+  }
+  int slot = *next;
+  *next = (*next + 1) % n;
+  return slot;
+}
+
+// the cached evaluation made one step h before `time` (the step's start), or NULL
+static const void* cache_step_start(const void* cache, size_t stride, int n, mjtNum time,
+                                    mjtNum h) {
+  const char* base = (const char*)cache;
+  for (int i = 0; i < n; i++) {
+    const evalHead* e = (const evalHead*)(base + i * stride);
+    if (e->valid && one_step_after(time, e->time, h)) return e;
+  }
+  return NULL;
+}
+
 static void store(jbData* c, const jbEval* ev) {
-  int slot = -1;
-  for (int i = 0; i < JB_NCACHE && slot < 0; i++) {
-    if (c->cache[i].valid && c->cache[i].time == ev->time) slot = i;
-  }
-  for (int i = 0; i < JB_NCACHE && slot < 0; i++) {
-    if (!c->cache[i].valid) slot = i;
-  }
-  if (slot < 0) {
-    slot = c->cache_next;
-    c->cache_next = (c->cache_next + 1) % JB_NCACHE;
-  }
-  c->cache[slot] = *ev;
+  c->cache[cache_slot(c->cache, sizeof(jbEval), JB_NCACHE, ev->time, &c->cache_next)] = *ev;
 }
 
 static void clear_cache(jbData* c) {
@@ -659,10 +682,7 @@ static void jb_advance(const mjModel* m, mjData* d, int instance) {
   jbData* c = (jbData*)d->plugin_data[instance];
   mjtNum* s = d->plugin_state + m->plugin_stateadr[instance];
   mjtNum h = m->opt.timestep;
-  const jbEval* ev = NULL;
-  for (int i = 0; i < JB_NCACHE && !ev; i++) {
-    if (c->cache[i].valid && one_step_after(d->time, c->cache[i].time, h)) ev = c->cache + i;
-  }
+  const jbEval* ev = (const jbEval*)cache_step_start(c->cache, sizeof(jbEval), JB_NCACHE, d->time, h);
   if (ev) {  // none when passive forces are disabled: no force was applied, nothing to record
     int consecutive = s[S_HAVE] != 0 && one_step_after(ev->time, s[S_TIME], h);
     s[S_WORK] += h * ev->power;
@@ -975,6 +995,278 @@ static void wm_advance(const mjModel* m, mjData* d, int instance) {
 }
 
 
+//==================================================================================================
+// clearance.backlash_stop: the stop at the ends of a backlash band, the gear mesh's impact law.
+//
+// A MuJoCo engine plugin (capabilities mjPLUGIN_PASSIVE | mjPLUGIN_SENSOR, needstage vel), one
+// instance per band. A hinge with backlash (clearance.retrofit.backlash) is a load hinge (the
+// link) and a motor hinge on the same axis; the load may turn within +-b of the motor. With
+//   r = q_load - q_motor      (the two hinges' qpos), s = sign(r) (the side of the band)
+//   delta = |r| - b            angular penetration past the band [rad] (negative: inside)
+//   delta_dot = s (v_load - v_motor)   its rate [rad/s] (> 0 closing)
+// the stop's torque is the angular Lankarani-Nikravesh law of laws.mesh_torque, reproduced
+// operation by operation:
+//   T = max(K delta^n (1 + chi (delta_dot / v_in)), 0) for delta > 0, else 0,
+//   chi = 3 (1 - e^2) / 4
+// and it is applied as passive generalized forces: -s T on the load dof and +s T on the motor
+// dof (the teeth push the two sides apart, back into the band). No tendon limit and no
+// constraint row is involved: the stop is the law itself, at whatever inertia the pose gives.
+// The approach speed v_in of an impact, the in-step treatment of the rates (half a step ahead
+// for the semi-implicit integrators), the onset located inside the step, the evaluation cache
+// and `advance` are those of clearance.journal_bearing (see its header above), with delta and
+// delta_dot as defined here; a sample taken on the other side of the band is no history (the
+// rate changes sign at r = 0).
+//
+// State (nstate = 11 mjtNums per instance; slots 0..3 and 6..10 as the journal bearing's):
+//   [0] time of the last recorded sample [s]    [1] delta there [rad]
+//   [2] geometric delta_dot there [rad/s]       [3] the same one step earlier [rad/s]
+//   [4] side s of the band there (+1, -1, 0)    [5] peak T of the current or last impact [N m]
+//   [6] recorded samples one step apart: 0, 1 or 2
+//   [7] 1 while in an impact, else 0            [8] approach speed of that impact [rad/s]
+//   [9] dissipated work so far [J]              [10] number of recorded steps
+//
+// Sensor output (nsensordata = 8), evaluated at the current state:
+//   [0] T stop torque [N m] (>= 0)    [1] -s T, the torque on the load hinge [N m]
+//   [2] delta [rad]                   [3] delta_dot entering the law [rad/s] (> 0 closing)
+//   [4] v_in approach speed [rad/s] (0 out of contact)
+//   [5] potential energy K delta^(n+1) / (n+1) [J] (0 for delta <= 0)
+//   [6] work dissipated by the stop so far [J] (>= 0)
+//   [7] peak T of the current impact, or of the last one once it has ended [N m]
+//
+// Config attributes (strings; validated in Python before compiling, re-checked here):
+//   load_joint, motor_joint   names of two distinct hinges
+//   half_width b [rad] > 0
+//   stiffness K [N m/rad^n] > 0, exponent n > 0 (default 1, a gear mesh)
+//   restitution e in [0, 1]
+//   min_approach_speed [rad/s] > 0 (default 1e-3, laws.MIN_APPROACH_SPEED)
+
+#define BS_NAME "clearance.backlash_stop"
+#define BS_NSENSOR 8
+
+enum { S_SIDE = S_VT, S_PEAK = S_VT2 };
+
+static const char* const kStopAttributes[] = {
+  "load_joint", "motor_joint", "half_width", "stiffness", "exponent", "restitution",
+  "min_approach_speed"
+};
+
+typedef struct {
+  mjtNum time;      // d->time of the evaluation
+  int valid;        // 1 if this cache slot holds an evaluation
+  mjtNum delta;     // penetration [rad]
+  mjtNum rate_geo;  // geometric penetration rate [rad/s]
+  mjtNum rate;      // rate entering the law [rad/s]
+  mjtNum side;      // s = sign(q_load - q_motor)
+  mjtNum vin;       // approach speed [rad/s] (0 out of contact)
+  mjtNum torque;    // T [N m]
+  mjtNum tel;       // elastic part K delta^n [N m]
+  mjtNum power;     // dissipated power [W]
+} bsEval;
+
+typedef struct {
+  int load_qpos, motor_qpos, load_dof, motor_dof;
+  mjtNum half_width, stiffness, exponent, restitution, chi, min_speed;
+  int nsensor;
+  int* sensor_adr;
+  bsEval cache[JB_NCACHE];
+  int cache_next;
+} bsData;
+
+static int read_hinge(const mjModel* m, int instance, const char* name, int* qpos, int* dof) {
+  const char* text = attr(m, instance, name);
+  int j = text ? mj_name2id(m, mjOBJ_JOINT, text) : -1;
+  if (j < 0 || m->jnt_type[j] != mjJNT_HINGE) {
+    mju_warning(BS_NAME " instance %d: attribute '%s' = '%s', expected the name of a hinge",
+                instance, name, text ? text : "");
+    return 0;
+  }
+  *qpos = m->jnt_qposadr[j];
+  *dof = m->jnt_dofadr[j];
+  return 1;
+}
+
+static int bs_configure(const mjModel* m, int instance, bsData* c) {
+  static const mjtNum kOne = 1.0, kMinSpeed = 1e-3;
+  if (!read_hinge(m, instance, "load_joint", &c->load_qpos, &c->load_dof) ||
+      !read_hinge(m, instance, "motor_joint", &c->motor_qpos, &c->motor_dof)) {
+    return 0;
+  }
+  if (c->load_dof == c->motor_dof) {
+    mju_warning(BS_NAME " instance %d: load_joint and motor_joint are the same hinge", instance);
+    return 0;
+  }
+  if (!read_number(m, instance, "half_width", NULL, &c->half_width) ||
+      !check(c->half_width > 0, instance, "half_width", c->half_width, "> 0 [rad]") ||
+      !read_number(m, instance, "stiffness", NULL, &c->stiffness) ||
+      !check(c->stiffness > 0, instance, "stiffness", c->stiffness, "> 0 [N m/rad^n]") ||
+      !read_number(m, instance, "exponent", &kOne, &c->exponent) ||
+      !check(c->exponent > 0, instance, "exponent", c->exponent, "> 0") ||
+      !read_number(m, instance, "restitution", NULL, &c->restitution) ||
+      !check(c->restitution >= 0 && c->restitution <= 1, instance, "restitution",
+             c->restitution, "in [0, 1]") ||
+      !read_number(m, instance, "min_approach_speed", &kMinSpeed, &c->min_speed) ||
+      !check(c->min_speed > 0, instance, "min_approach_speed", c->min_speed, "> 0 [rad/s]")) {
+    return 0;
+  }
+  c->chi = hysteresis(LAW_LN, c->restitution);
+  return 1;
+}
+
+// evaluate the stop at the current state of d; pure in (d, state)
+static void bs_evaluate(const mjModel* m, const mjData* d, const bsData* c, const mjtNum* s,
+                        bsEval* ev) {
+  mjtNum r = d->qpos[c->load_qpos] - d->qpos[c->motor_qpos];
+  mjtNum side = r > 0 ? 1.0 : (r < 0 ? -1.0 : 0.0);
+  mjtNum delta = mju_abs(r) - c->half_width;
+  mjtNum rate_geo = side * (d->qvel[c->load_dof] - d->qvel[c->motor_dof]);
+
+  // a sample from the other side of the band is no history
+  int same_side = s[S_SIDE] == side;
+  mjtNum rate = same_side ? half_step_ahead(m, d, s, rate_geo, s[S_RATE], s[S_RATE2]) : rate_geo;
+
+  mjtNum vin = 0;
+  if (delta > 0) {
+    if (s[S_CONTACT] != 0 && same_side) {
+      vin = s[S_VIN];
+    } else if (same_side && sample_is_recent(m, d, s) && s[S_DELTA] <= 0) {
+      mjtNum theta = s[S_DELTA] / (s[S_DELTA] - delta);
+      mjtNum w = (semi_implicit(m) && sample_is_last_step(m, d, s)) ? theta + 0.5 : theta;
+      vin = s[S_RATE] + w * (rate_geo - s[S_RATE]);
+    } else {
+      vin = rate;
+    }
+    vin = vin > c->min_speed ? vin : c->min_speed;
+  }
+
+  mjtNum tel = 0, torque = 0;
+  if (delta > 0) {
+    tel = c->stiffness * pow(delta, c->exponent);
+    torque = tel * (1.0 + c->chi * (rate / vin));
+    torque = torque > 0 ? torque : 0.0;
+  }
+  ev->time = d->time;
+  ev->valid = 1;
+  ev->delta = delta;
+  ev->rate_geo = rate_geo;
+  ev->rate = rate;
+  ev->side = side;
+  ev->vin = vin;
+  ev->torque = torque;
+  ev->tel = tel;
+  ev->power = delta > 0 ? (torque - tel) * rate : 0.0;
+}
+
+static int bs_nsensordata(const mjModel* m, int instance, int sensor_id) {
+  return BS_NSENSOR;
+}
+
+static int bs_init(const mjModel* m, mjData* d, int instance) {
+  bsData* c = (bsData*)calloc(1, sizeof(bsData));
+  if (!c) {
+    mju_warning(BS_NAME " instance %d: out of memory", instance);
+    return -1;
+  }
+  if (!bs_configure(m, instance, c)) {
+    free(c);
+    return -1;
+  }
+  c->sensor_adr = instance_sensors(m, instance, &c->nsensor);
+  if (!c->sensor_adr) {
+    free(c);
+    mju_warning(BS_NAME " instance %d: out of memory", instance);
+    return -1;
+  }
+  d->plugin_data[instance] = (uintptr_t)c;
+  return 0;
+}
+
+static void bs_destroy(mjData* d, int instance) {
+  bsData* c = (bsData*)d->plugin_data[instance];
+  if (c) {
+    free(c->sensor_adr);
+    free(c);
+  }
+  d->plugin_data[instance] = 0;
+}
+
+static void bs_copy(mjData* dest, const mjModel* m, const mjData* src, int instance) {
+  bsData* to = (bsData*)dest->plugin_data[instance];
+  const bsData* from = (const bsData*)src->plugin_data[instance];
+  if (to && from) {
+    memcpy(to->cache, from->cache, sizeof(to->cache));
+    to->cache_next = from->cache_next;
+  }
+}
+
+static void bs_clear_cache(bsData* c) {
+  for (int i = 0; i < JB_NCACHE; i++) {
+    c->cache[i].valid = 0;
+  }
+  c->cache_next = 0;
+}
+
+static void bs_reset(const mjModel* m, mjtNum* plugin_state, void* plugin_data, int instance) {
+  mju_zero(plugin_state, JB_NSTATE);
+  if (plugin_data) {
+    bs_clear_cache((bsData*)plugin_data);
+  }
+}
+
+static void bs_compute(const mjModel* m, mjData* d, int instance, int capability_bit) {
+  bsData* c = (bsData*)d->plugin_data[instance];
+  const mjtNum* s = d->plugin_state + m->plugin_stateadr[instance];
+  bsEval ev;
+  bs_evaluate(m, d, c, s, &ev);
+
+  if (capability_bit & mjPLUGIN_PASSIVE) {
+    c->cache[cache_slot(c->cache, sizeof(bsEval), JB_NCACHE, ev.time, &c->cache_next)] = ev;
+    if (ev.torque != 0) {
+      d->qfrc_passive[c->load_dof] -= ev.side * ev.torque;
+      d->qfrc_passive[c->motor_dof] += ev.side * ev.torque;
+    }
+  }
+
+  if (capability_bit & mjPLUGIN_SENSOR) {
+    mjtNum peak = ev.delta > 0 && s[S_CONTACT] != 0 ? mju_max(s[S_PEAK], ev.torque)
+                                                    : (ev.delta > 0 ? ev.torque : s[S_PEAK]);
+    mjtNum out[BS_NSENSOR] = {
+      ev.torque, -ev.side * ev.torque, ev.delta, ev.rate, ev.vin,
+      ev.delta > 0 ? ev.tel * ev.delta / (c->exponent + 1) : 0.0,
+      s[S_WORK], peak
+    };
+    for (int i = 0; i < c->nsensor; i++) {
+      mju_copy(d->sensordata + c->sensor_adr[i], out, BS_NSENSOR);
+    }
+  }
+}
+
+// once per step, after integration: commit the evaluation made at the step's start state
+static void bs_advance(const mjModel* m, mjData* d, int instance) {
+  bsData* c = (bsData*)d->plugin_data[instance];
+  mjtNum* s = d->plugin_state + m->plugin_stateadr[instance];
+  mjtNum h = m->opt.timestep;
+  const bsEval* ev = (const bsEval*)cache_step_start(c->cache, sizeof(bsEval), JB_NCACHE,
+                                                      d->time, h);
+  if (ev) {
+    int consecutive = s[S_HAVE] != 0 && one_step_after(ev->time, s[S_TIME], h) &&
+                      s[S_SIDE] == ev->side;
+    int onset = ev->delta > 0 && !(s[S_CONTACT] != 0 && s[S_SIDE] == ev->side);
+    s[S_WORK] += h * ev->power;
+    s[S_PEAK] = onset ? ev->torque : (ev->delta > 0 ? mju_max(s[S_PEAK], ev->torque) : s[S_PEAK]);
+    s[S_CONTACT] = ev->delta > 0 ? 1.0 : 0.0;
+    s[S_VIN] = ev->delta > 0 ? ev->vin : 0.0;
+    s[S_RATE2] = consecutive ? s[S_RATE] : 0.0;
+    s[S_HAVE] = consecutive ? 2.0 : 1.0;
+    s[S_TIME] = ev->time;
+    s[S_DELTA] = ev->delta;
+    s[S_RATE] = ev->rate_geo;
+    s[S_SIDE] = ev->side;
+    s[S_NSTEP] += 1.0;
+  }
+  bs_clear_cache(c);
+}
+
+
 //---------------------------------- registration --------------------------------------------------
 
 mjPLUGIN_LIB_INIT(clearance_journal_bearing) {
@@ -1011,4 +1303,21 @@ mjPLUGIN_LIB_INIT(clearance_journal_bearing) {
   work.compute = wm_compute;
   work.advance = wm_advance;
   mjp_registerPlugin(&work);
+
+  mjpPlugin stop;
+  mjp_defaultPlugin(&stop);
+  stop.name = BS_NAME;
+  stop.capabilityflags |= mjPLUGIN_PASSIVE | mjPLUGIN_SENSOR;
+  stop.needstage = mjSTAGE_VEL;
+  stop.nattribute = sizeof(kStopAttributes) / sizeof(kStopAttributes[0]);
+  stop.attributes = kStopAttributes;
+  stop.nstate = jb_nstate;
+  stop.nsensordata = bs_nsensordata;
+  stop.init = bs_init;
+  stop.destroy = bs_destroy;
+  stop.copy = bs_copy;
+  stop.reset = bs_reset;
+  stop.compute = bs_compute;
+  stop.advance = bs_advance;
+  mjp_registerPlugin(&stop);
 }

@@ -14,7 +14,8 @@ The stop at either end of the band is calibrated to the gear mesh's impact law w
 ``mesh_stiffness`` K [N m/rad] (default 1e4: a small robot gearbox's torsional stiffness, as
 strain-wave gear catalogues give it, recalled) and ``restitution`` e (default 0.8: lubricated
 steel teeth, recalled): ``--joint elbow:backlash_arcmin=5,mesh_stiffness=3e4,restitution=0.7``;
-``--backlash-stop recipe`` keeps MuJoCo's default limit instead; ``--backlash-sensors motor`` puts the
+``--backlash-stop recipe`` keeps MuJoCo's default limit instead, ``--backlash-stop exact`` closes the band
+with the law itself (the compiled plugin); ``--backlash-sensors motor`` puts the
 hinge's jointpos and jointvel sensors on the motor side. Every --joint then names
 backlash, and the play, numerics and sizing options do not apply.
 """
@@ -168,11 +169,12 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     p.add_argument(
         "--backlash-stop",
         default="calibrated",
-        choices=("calibrated", "recipe"),
+        choices=("calibrated", "recipe", "exact"),
         help="the stop at the ends of a backlash band: calibrated (default: fitted to the gear mesh's impact law, "
         "mesh_stiffness default 1e4 N m/rad and restitution 0.8, both recalled typical values; the time step is "
-        "lowered where the stop needs it) or recipe (MuJoCo's two hinges and a limit at its default solref and "
-        "solimp, the model's time step)",
+        "lowered where the stop needs it), exact (the law itself, computed by the compiled plugin "
+        "clearance.backlash_stop; the same time step rule; the written model needs the plugin) or recipe (MuJoCo's "
+        "two hinges and a limit at its default solref and solimp, the model's time step)",
     )
     p.add_argument(
         "--backlash-sensors",

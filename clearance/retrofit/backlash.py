@@ -11,7 +11,10 @@ meaning. The stop at either end of the band is calibrated (`Backlash.stop` = 'ca
 the tendon limit's solreflimit and solimplimit fitted to the gear mesh's impact law at the
 band's effective inertia, and the model's time step lowered where the stop needs it
 (`clearance.retrofit.backlash_stop`); or MuJoCo's default limit at the model's step, the
-recipe as users write it ('recipe').
+recipe as users write it ('recipe'); or the mesh law itself ('exact'): the tendon is then left
+unlimited (it still reads the band's angle) and a `clearance.backlash_stop` plugin instance
+``clr_<hinge>__stop`` (`clearance.contact_plugin.backlash_stop`) applies the law's torque to the
+two hinges, at the time step a calibrated stop would ask for.
 
 A limited hinge's limit is copied to its motor hinge (range, solref, solimp, margin): the
 twin's limit stopped the link with the rotor's inertia behind it, and MuJoCo's limit is
@@ -34,6 +37,8 @@ import mujoco
 import numpy as np
 
 from clearance.contact_calibration.torsional_stop import OMEGA_H
+from clearance.contact_plugin import require
+from clearance.contact_plugin.backlash_stop import add_backlash_stop
 from clearance.retrofit.backlash_stop import Band, BandStop, calibrate_stops
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.play import PREFIX, Backlash, RetrofitError
@@ -46,6 +51,7 @@ __all__ = [
     "BacklashRetrofit",
     "add_backlash",
     "motor_joint_name",
+    "stop_plugin_name",
 ]
 
 MOTOR_MASS = 1e-12
@@ -79,6 +85,11 @@ def motor_joint_name(hinge: str) -> str:
     return f"{hinge}__motor"
 
 
+def stop_plugin_name(hinge: str) -> str:
+    """The plugin instance (and its sensor) of ``hinge``'s exact stop."""
+    return f"{PREFIX}{hinge}__stop"
+
+
 @dataclass(frozen=True)
 class BacklashHinge:
     """One hinge given backlash.
@@ -88,7 +99,7 @@ class BacklashHinge:
         backlash: what was asked.
         motor_joint: the motor side's hinge.
         motor_body: the motor body.
-        tendon: the dead band's tendon (q_load - q_motor, limited to +-b).
+        tendon: the dead band's tendon (q_load - q_motor; limited to +-b unless the stop is 'exact').
         actuators: names (or ``#k``) of the actuators moved to the motor side.
         motor_armature: the motor hinge's armature [kg m^2].
         armature_source: where it came from ('the hinge's armature (moved)', 'given', or the
@@ -156,6 +167,12 @@ def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backl
             raise RetrofitError(
                 f"hinge '{name}': its body has {twin.body_jntnum[body]} joints; backlash needs it alone"
             )
+        if play.stop == "exact":
+            for obj in (mujoco.mjtObj.mjOBJ_PLUGIN, mujoco.mjtObj.mjOBJ_SENSOR):
+                if mujoco.mj_name2id(twin, obj, stop_plugin_name(name)) >= 0:
+                    raise RetrofitError(
+                        f"hinge '{name}': {where} already has an element named '{stop_plugin_name(name)}'"
+                    )
         for clash in (motor_joint_name(name), f"{PREFIX}{name}__motor", f"{PREFIX}{name}__backlash"):
             for obj in (mujoco.mjtObj.mjOBJ_JOINT, mujoco.mjtObj.mjOBJ_BODY, mujoco.mjtObj.mjOBJ_TENDON):
                 if mujoco.mj_name2id(twin, obj, clash) >= 0:
@@ -183,6 +200,8 @@ def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backl
                 "link, and an unactuated hinge has no motor side"
             )
         actuated[name] = on_joint
+    if any(play.stop == "exact" for play in joints.values()):
+        require()  # the exact stop is the compiled plugin: say how to get it before any work
     return actuated
 
 
@@ -278,11 +297,21 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
             margin=twin.jnt_margin[j],
         )
         tendon = f"{PREFIX}{name}__backlash"
-        band = work.add_tendon(
-            name=tendon, limited=mujoco.mjtLimited.mjLIMITED_TRUE, range=[-play.half_width, play.half_width]
-        )
+        limited = mujoco.mjtLimited.mjLIMITED_FALSE if play.stop == "exact" else mujoco.mjtLimited.mjLIMITED_TRUE
+        band = work.add_tendon(name=tendon, limited=limited, range=[-play.half_width, play.half_width])
         band.wrap_joint(name, 1.0)
         band.wrap_joint(motor_joint_name(name), -1.0)
+        if play.stop == "exact":
+            add_backlash_stop(
+                work,
+                name=stop_plugin_name(name),
+                load_joint=name,
+                motor_joint=motor_joint_name(name),
+                half_width=play.half_width,
+                stiffness=play.mesh_stiffness,
+                restitution=play.restitution,
+                exponent=play.mesh_exponent,
+            )
         for k in actuated[name]:
             actuators[k].target = motor_joint_name(name)
         sensors[name] = _move_sensors(work, name, play)
@@ -325,7 +354,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     notes = [
         f"hinge '{h.name}': actuators {', '.join(h.actuators)} moved to '{h.motor_joint}' (armature "
         f"{h.motor_armature:.4g} kg m^2, {h.armature_source}); dead band +-{h.backlash.half_width:.4g} rad by the "
-        f"limit of tendon '{h.tendon}', {_stop_note(h.stop)}; "
+        f"{_band_note(h)}, {_stop_note(h.stop)}; "
         + (
             f"sensors on the motor side: {', '.join(h.moved_sensors)}"
             if h.moved_sensors
@@ -335,15 +364,27 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     ]
     if timestep < twin.opt.timestep:
         notes.append(
-            f"time step lowered from {twin.opt.timestep:g} s to {timestep:g} s for the calibrated stops "
+            f"time step lowered from {twin.opt.timestep:g} s to {timestep:g} s for the calibrated or exact stops "
             f"(omega*h <= {OMEGA_H:g} with omega = sqrt(K/J) at the lightest pose sampled); run the twin at this step "
             "to compare"
         )
     return BacklashRetrofit(work, model, twin_spec, twin, done, nkeys, notes, timestep)
 
 
+def _band_note(h: BacklashHinge) -> str:
+    """What closes a band: the tendon's limit, or the exact stop's plugin."""
+    if h.stop.kind == "exact":
+        return f"tendon '{h.tendon}' (unlimited, the band's angle) closed by plugin '{stop_plugin_name(h.name)}'"
+    return f"limit of tendon '{h.tendon}'"
+
+
 def _stop_note(stop: BandStop) -> str:
     """One line on a band's stop."""
+    if stop.kind == "exact":
+        return (
+            "the mesh law itself, exact (compiled plugin clearance.backlash_stop; effective inertia "
+            f"{stop.inertia:.4g} kg m^2)"
+        )
     if stop.fit is None:
         return f"MuJoCo's default stop (the recipe, not calibrated; effective inertia {stop.inertia:.4g} kg m^2)"
     worst = max(max(abs(r.peak_torque_err), abs(r.restitution_err)) for r in stop.fit.rows)

@@ -4,8 +4,9 @@ For every hinge: the motor side that took its actuators, the band, and the stop 
 for a calibrated stop the mesh law (K, cₑ, n), the effective inertia along the band, the
 closing speeds fitted over (a decade around the stated estimate), the emitted solreflimit and
 solimplimit, and a table of the stop's peak torque and restitution against the law's at each
-speed; for the recipe, that the stop is MuJoCo's default limit. The time step, where the
-calibrated stops lowered it, is stated with the twin's.
+speed; for an exact stop, the mesh law and that the compiled plugin computes it; for the
+recipe, that the stop is MuJoCo's default limit. The time step, where the calibrated or exact
+stops lowered it, is stated with the twin's.
 """
 
 from __future__ import annotations
@@ -50,6 +51,13 @@ def _stop_rows(hinges: Sequence[BacklashHinge]) -> list[str]:
     for h in hinges:
         s, fit = h.stop, h.stop.fit
         speed = f"{s.impact_speed:.3g} ({s.speed_source})"
+        if s.kind == "exact":
+            law = h.backlash
+            lines.append(
+                f"| {h.name} | exact (the law, compiled plugin) | {law.mesh_stiffness:.6g} | {law.restitution:g} | "
+                f"{law.mesh_exponent:g} | {s.inertia:.4g} | {speed} | - | - | none (tendon unlimited) | - |"
+            )
+            continue
         if fit is None or s.solref is None:
             lines.append(
                 f"| {h.name} | recipe (MuJoCo's default limit) | - | - | - | {s.inertia:.4g} | {speed} | - | - | "
@@ -135,7 +143,11 @@ def backlash_report(
         "(solimplimit), so the limit is a penalty spring-damper whatever the pose. The impact speed is estimated "
         "as the speed at which the motor, pushed from rest by its actuators' largest torque, takes up the whole "
         f"band. The time step keeps omega h <= {OMEGA_H:g} with omega = sqrt(K/J) at the lightest pose sampled. "
-        "A recipe stop is MuJoCo's "
+        "An exact stop is the law itself: the compiled plugin `clearance.backlash_stop` (one instance "
+        "`clr_<hinge>__stop` per band, with a sensor of the torque, d and d') computes T from the two hinges' angles "
+        "and speeds, keeps the closing speed of each impact, and applies T to both hinges as passive torques; the "
+        "band's tendon stays, unlimited, as its angle. It holds at every pose, and the model needs the plugin "
+        "wherever it is loaded; its time step follows the same omega h rule. A recipe stop is MuJoCo's "
         "default limit (solref 0.02 1, solimp 0.9 0.95 0.001) at the model's own step: the two hinges and a limit "
         "as users write them, not calibrated.",
         "",
@@ -147,7 +159,7 @@ def backlash_report(
     lines.append("")
     if step < twin_step:
         lines.append(
-            f"Time step: {step:g} s, lowered from the model's {twin_step:g} s for the calibrated stops "
+            f"Time step: {step:g} s, lowered from the model's {twin_step:g} s for the calibrated or exact stops "
             "(`original.xml` keeps the model's own; run the twin at this step to compare)."
         )
     else:

@@ -17,7 +17,8 @@ model with its motor bodies added:
 - for a 'calibrated' stop, the time step (`torsional_stop.stop_timestep`, the smallest over
   the bands) and the fit of the tendon limit's solreflimit and solimplimit to the mesh law over
   a decade of closing speeds (`torsional_stop.fit_stop`) at that step and the model's
-  integrator. A 'recipe' stop keeps MuJoCo's default limit and the model's step.
+  integrator. An 'exact' stop (the law itself, in the compiled plugin) needs no fit but the
+  same time step rule. A 'recipe' stop keeps MuJoCo's default limit and the model's step.
 """
 
 from __future__ import annotations
@@ -83,17 +84,17 @@ class BandStop:
     """The stop of one band.
 
     Attributes:
-        kind: 'calibrated' or 'recipe'.
+        kind: 'calibrated', 'recipe' or 'exact'.
         inertia: effective inertia J along the band at the reference pose [kg m^2].
         invweight: the tendon's inverse weight Â at qpos0 (MuJoCo's ``tendon_invweight0``) [1/(kg m^2)].
         impact_speed: the closing speed fitted around [rad/s].
         speed_source: how ``impact_speed`` was found.
-        fit: the fitted stop (None for 'recipe').
+        fit: the fitted stop (None for 'recipe' and 'exact').
         solref: solreflimit emitted (None: MuJoCo's default).
         solimp: solimplimit emitted (None: MuJoCo's default).
         inertia_range: (lightest, heaviest) effective inertia over the sampled poses [kg m^2].
         pose_rows: the fitted stop against the law at the impact speed at the lightest and the
-            heaviest pose (empty for 'recipe').
+            heaviest pose (empty for 'recipe' and 'exact').
     """
 
     kind: str
@@ -212,7 +213,7 @@ def calibrate_stops(model: mujoco.MjModel, bands: Mapping[str, Band]) -> tuple[f
     speeds = {name: impact_speed(model, b) for name, b in bands.items()}
     step = float(model.opt.timestep)
     for name, b in bands.items():
-        if b.backlash.stop == "calibrated":
+        if b.backlash.stop in ("calibrated", "exact"):
             top = float(stop_speeds(speeds[name][0])[-1])
             step = min(step, stop_timestep(laws[name], ranges[name][0], float(model.opt.timestep), top))
     out: dict[str, BandStop] = {}
@@ -220,7 +221,8 @@ def calibrate_stops(model: mujoco.MjModel, bands: Mapping[str, Band]) -> tuple[f
         speed, source = speeds[name]
         invweight = float(model.tendon_invweight0[b.tendon])
         if b.backlash.stop != "calibrated":
-            out[name] = BandStop("recipe", inertia[name], invweight, speed, source, None, None, None, ranges[name])
+            kind = b.backlash.stop
+            out[name] = BandStop(kind, inertia[name], invweight, speed, source, None, None, None, ranges[name])
             continue
         fit = fit_stop(
             laws[name],

@@ -63,9 +63,13 @@ class BacklashRecord:
         name: the hinge (the load side, the link).
         motor_joint: the motor side's hinge on the same axis (it takes the actuators).
         motor_body: the motor body.
-        tendon: the dead band's fixed tendon, q_load - q_motor, limited to +-``half_width``.
+        tendon: the dead band's fixed tendon, q_load - q_motor, limited to +-``half_width``
+            (unlimited for an 'exact' stop).
         half_width: b [rad].
         actuators: the actuators moved to the motor side (names, or ``#k``).
+        stop: what closes the band, one of `clearance.retrofit.play.STOPS`; records written
+            before the exact stop existed have none and read as 'calibrated' (a tendon limit,
+            which is all a run needs to know of a 'recipe' stop too).
     """
 
     name: str
@@ -74,6 +78,7 @@ class BacklashRecord:
     tendon: str
     half_width: float
     actuators: tuple[str, ...]
+    stop: str = "calibrated"
 
 
 @dataclass(frozen=True)

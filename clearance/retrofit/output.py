@@ -171,7 +171,7 @@ def backlash_manifest_of(result: BacklashRetrofit) -> RetrofitManifest:
         qpos += range(int(model.jnt_qposadr[jm]), int(model.jnt_qposadr[jm]) + nq)
         qvel += range(int(model.jnt_dofadr[jm]), int(model.jnt_dofadr[jm]) + nv)
     records = tuple(
-        BacklashRecord(h.name, h.motor_joint, h.motor_body, h.tendon, h.backlash.half_width, h.actuators)
+        BacklashRecord(h.name, h.motor_joint, h.motor_body, h.tendon, h.backlash.half_width, h.actuators, h.stop.kind)
         for h in result.hinges.values()
     )
     step = float(model.opt.timestep)

@@ -134,10 +134,13 @@ DEFAULT_MESH_RESTITUTION = 0.8
 teeth, as gear-rattle models take it (about 0.6 to 0.9; recalled, not checked), in the range
 where Lankarani–Nikravesh holds (cₑ >= 0.7)."""
 
-STOPS = ("calibrated", "recipe")
+STOPS = ("calibrated", "recipe", "exact")
 """What closes a dead band: 'calibrated' (the tendon limit fitted to the mesh law,
-`clearance.contact_calibration.torsional_stop`) or 'recipe' (the same limit at MuJoCo's
-default solref and solimp, the two-hinges-and-a-limit recipe, and the model's time step)."""
+`clearance.contact_calibration.torsional_stop`), 'recipe' (the same limit at MuJoCo's
+default solref and solimp, the two-hinges-and-a-limit recipe, and the model's time step) or
+'exact' (no limit: the mesh law itself, computed by the compiled plugin
+`clearance.backlash_stop`, `clearance.contact_plugin.backlash_stop`; the written model then
+needs the plugin)."""
 
 SENSOR_SIDES = ("load", "motor")
 """Where a backlashed hinge's jointpos and jointvel sensors read: 'load' (the link, the
@@ -166,7 +169,7 @@ class Backlash:
         mesh_exponent: n [-], >= 1 (1: a gear mesh is a linear spring).
         impact_speed: the closing speed the stop is fitted around [rad/s] (a decade about it);
             None: estimated from the model (`clearance.retrofit.backlash.impact_speed`).
-        stop: one of `STOPS` ('calibrated' unless 'recipe' is asked for).
+        stop: one of `STOPS` ('calibrated' unless 'recipe' or 'exact' is asked for).
         sensors: one of `SENSOR_SIDES`: where the hinge's position and velocity sensors
             read ('load', the default: the link's angle, as before the edit; 'motor': the
             motor side's, as an encoder on the motor reads it).

@@ -1,0 +1,152 @@
+"""Add `clearance.backlash_stop` plugin instances to an MjSpec: the exact stop of a backlash band.
+
+One instance per band closes the dead band ±b between a load hinge and a motor hinge on the
+same axis with the gear mesh's impact law, `clearance.contact_calibration.laws.mesh_torque`
+(angular Lankarani–Nikravesh, T = K δⁿ [1 + 3(1 − cₑ²)/4 · δ̇/δ̇⁻], δ = |q_load − q_motor| − b),
+evaluated in C operation by operation and applied as passive torques (−s T on the load, +s T
+on the motor, s the side of the band). The approach speed δ̇⁻ of each impact is kept in the
+plugin's state; the C file's section on this plugin is the full specification.
+
+Every attribute is validated here, in Python, before anything is compiled (as
+`clearance.contact_plugin.attributes` does for the journal bearing).
+
+Sensor block: each instance gets one plugin sensor of 8 values, `SENSOR_FIELDS` in order:
+
+====  ===================  ======  =========================================================
+slot  field                unit    meaning
+====  ===================  ======  =========================================================
+0     torque               N m     T >= 0 of the law
+1     load_torque          N m     −s T, the stop's torque on the load hinge
+2     penetration          rad     δ = |q_load − q_motor| − b (negative: inside the band)
+3     penetration_rate     rad/s   δ̇ entering the law (> 0 closing)
+4     approach_speed       rad/s   δ̇⁻ of the current impact (0 out of contact)
+5     potential_energy     J       K δ^(n+1)/(n+1) for δ > 0, else 0
+6     dissipated_work      J       the law's damping work so far (>= 0)
+7     impact_peak_torque   N m     largest T of the current impact, or of the last one
+====  ===================  ======  =========================================================
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import mujoco
+
+from clearance.contact_calibration import laws
+from clearance.contact_plugin import require
+
+__all__ = ["PLUGIN_NAME", "SENSOR_FIELDS", "add_backlash_stop", "sensor_offsets"]
+
+PLUGIN_NAME = "clearance.backlash_stop"
+"""Name under which the library registers the backlash stop with MuJoCo."""
+
+SENSOR_FIELDS: tuple[str, ...] = (
+    "torque",
+    "load_torque",
+    "penetration",
+    "penetration_rate",
+    "approach_speed",
+    "potential_energy",
+    "dissipated_work",
+    "impact_peak_torque",
+)
+"""Names of the plugin sensor's values, in order (units in the module docstring)."""
+
+
+def _number(stop: str, attribute: str, value: Any, expected: str, ok: Any) -> float:
+    """``value`` as a float if finite and ``ok(value)``, else a ValueError saying what was expected."""
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(float(value)):
+        raise ValueError(f"backlash stop '{stop}': {attribute} must be a finite number {expected} (got {value!r})")
+    v = float(value)
+    if not ok(v):
+        raise ValueError(f"backlash stop '{stop}': {attribute} must be {expected} (got {value!r})")
+    return v
+
+
+def _hinge(spec: mujoco.MjSpec, stop: str, attribute: str, name: Any) -> str:
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"backlash stop '{stop}': {attribute} must be a hinge name (got {name!r})")
+    joint = spec.joint(name)
+    if joint is None or joint.type != mujoco.mjtJoint.mjJNT_HINGE:
+        raise ValueError(f"backlash stop '{stop}': {attribute} = {name!r} is not a hinge of the spec")
+    return name
+
+
+def add_backlash_stop(
+    spec: mujoco.MjSpec,
+    *,
+    name: str,
+    load_joint: str,
+    motor_joint: str,
+    half_width: float,
+    stiffness: float,
+    restitution: float,
+    exponent: float = laws.GEAR_MESH_EXPONENT,
+    min_approach_speed: float = laws.MIN_APPROACH_SPEED,
+) -> None:
+    """Add one exact backlash stop (plugin instance + its sensor, both named ``name``).
+
+    Args:
+        spec: the model under construction; modified in place.
+        name: name of the plugin instance and of its sensor (unique among both).
+        load_joint: the load side's hinge (the link).
+        motor_joint: the motor side's hinge on the same axis.
+        half_width: b [rad], > 0.
+        stiffness: K [N m/rad^n], > 0.
+        restitution: cₑ [-], in [0, 1].
+        exponent: n [-], > 0 (1 for a gear mesh).
+        min_approach_speed: floor on the recorded approach speed δ̇⁻ [rad/s], > 0.
+
+    Raises:
+        ValueError: naming the stop, the attribute, its value and what was expected: a name
+            already used, a joint that is not a hinge of the spec, the same hinge twice, a
+            non-finite or out-of-range number.
+        clearance.contact_plugin.PluginUnavailableError: if the package was installed without
+            the compiled plugin (checked after the attributes).
+    """
+    if not isinstance(name, str) or not name:
+        raise ValueError(f"backlash stop: name must be a non-empty string (got {name!r})")
+    if any(p.name == name for p in spec.plugins) or spec.sensor(name) is not None:
+        raise ValueError(
+            f"backlash stop '{name}': name {name!r} is already used by a plugin instance or a sensor of the spec"
+        )
+    load = _hinge(spec, name, "load_joint", load_joint)
+    motor = _hinge(spec, name, "motor_joint", motor_joint)
+    if load == motor:
+        raise ValueError(f"backlash stop '{name}': load_joint and motor_joint are both {load!r}; expected two hinges")
+    config = {
+        "load_joint": load,
+        "motor_joint": motor,
+        "half_width": _number(name, "half_width", half_width, "> 0 [rad]", lambda v: v > 0),
+        "stiffness": _number(name, "stiffness", stiffness, "> 0 [N m/rad^n]", lambda v: v > 0),
+        "exponent": _number(name, "exponent", exponent, "> 0", lambda v: v > 0),
+        "restitution": _number(name, "restitution", restitution, "in [0, 1]", lambda v: 0 <= v <= 1),
+        "min_approach_speed": _number(name, "min_approach_speed", min_approach_speed, "> 0 [rad/s]", lambda v: v > 0),
+    }
+    require()
+    spec.activate_plugin(PLUGIN_NAME)
+    plugin = spec.add_plugin(name=name, plugin_name=PLUGIN_NAME, active=True)
+    plugin.config = {k: v if isinstance(v, str) else repr(v) for k, v in config.items()}
+    sensor = spec.add_sensor(name=name, type=mujoco.mjtSensor.mjSENS_PLUGIN)
+    sensor.plugin = plugin
+
+
+def sensor_offsets(model: mujoco.MjModel, name: str) -> dict[str, int]:
+    """Index in ``mjData.sensordata`` (and in rollout sensor arrays) of each field of a stop's sensor.
+
+    Args:
+        model: a compiled model.
+        name: the stop's name (as given to `add_backlash_stop`).
+
+    Returns:
+        ``{field: index}`` for every field of `SENSOR_FIELDS`.
+
+    Raises:
+        ValueError: if the model has no such plugin sensor.
+    """
+    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, name)
+    if i < 0 or model.sensor_type[i] != mujoco.mjtSensor.mjSENS_PLUGIN or model.sensor_dim[i] != len(SENSOR_FIELDS):
+        raise ValueError(f"the model has no backlash stop sensor named {name!r}")
+    adr = int(model.sensor_adr[i])
+    return {field: adr + k for k, field in enumerate(SENSOR_FIELDS)}
