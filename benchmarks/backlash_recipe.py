@@ -5,8 +5,9 @@ Three cases, each with backlash at every actuated hinge (`clearance.retrofit.add
 - a flywheel (a 1 kg, 0.1 m disc on an actuated hinge with armature 0.002 kg m^2, 1 ms step):
   its load set spinning into the stop at five closing speeds over a decade, the stop's peak
   torque and restitution against the mesh law's 1-DOF impact (`impact.law_impact`), for the
-  calibrated stop (its own step) and the recipe (the model's step); then 1 s of a sinusoidal
-  drive, the rim point's deviation from the unmodified twin;
+  calibrated stop (its own step), the exact stop (the law in the compiled plugin
+  `clearance.backlash_stop`, at the same step rule) and the recipe (the model's step); then 1 s
+  of a sinusoidal drive, the rim point's deviation from the unmodified twin;
 - gymnasium's reacher and pusher under 1 s of the sizing sinusoid (`SineControl()`): per band
   the peak stop torque, the impacts and their median rebound (the band's opening rate after a
   release over its closing rate at the onset), the widest opening over b, and the end
@@ -36,7 +37,7 @@ import numpy as np
 from clearance.contact_calibration.impact import law_impact
 from clearance.model import ContactLaw
 from clearance.retrofit import Backlash, SineControl
-from clearance.retrofit.backlash import BacklashRetrofit, add_backlash
+from clearance.retrofit.backlash import BacklashRetrofit, add_backlash, stop_plugin_name
 from clearance.retrofit.motion import control_signal, initial_data
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -71,14 +72,19 @@ def _limit_rows(data: mujoco.MjData) -> dict[int, float]:
 
 
 def flywheel_impact(model: mujoco.MjModel, speed: float) -> tuple[float, float]:
-    """(peak stop torque [N m], restitution [-]) of the flywheel's load closing on the stop at ``speed``."""
+    """(peak stop torque [N m], restitution [-]) of the flywheel's load closing on the stop at ``speed``.
+
+    The torque is the tendon limit's row force, or for an exact stop its plugin sensor's torque.
+    """
     d = mujoco.MjData(model)
     load, motor = model.joint("shaft").dofadr[0], model.joint("shaft__motor").dofadr[0]
+    exact = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, stop_plugin_name("shaft"))
+    adr = int(model.sensor_adr[exact]) if exact >= 0 else -1
     d.qvel[load] = speed
     peak, touched = 0.0, False
     for _ in range(int(50 * FLYWHEEL_B / speed / model.opt.timestep) + 2000):
         mujoco.mj_step(model, d)
-        rows = _limit_rows(d)
+        rows = _limit_rows(d) if adr < 0 else ({0: float(d.sensordata[adr])} if d.sensordata[adr + 2] > 0 else {})
         if rows:
             touched = True
             peak = max(peak, *rows.values())
@@ -166,17 +172,19 @@ def _fmt(values: list[float], spec: str) -> str:
 def _flywheel_section() -> list[str]:
     cal = add_backlash(mujoco.MjSpec.from_string(FLYWHEEL), {"shaft": Backlash(FLYWHEEL_B)})
     rec = add_backlash(mujoco.MjSpec.from_string(FLYWHEEL), {"shaft": Backlash(FLYWHEEL_B, stop="recipe")})
+    ex = add_backlash(mujoco.MjSpec.from_string(FLYWHEEL), {"shaft": Backlash(FLYWHEEL_B, stop="exact")})
     stop = cal.hinges["shaft"].stop
     lines = [
         "## Flywheel: impacts at known closing speeds",
         "",
         f"Band +-{math.degrees(FLYWHEEL_B) * 60:g}'; effective inertia J = {stop.inertia:.5g} kg m^2 (the disc's "
         "0.005 and the armature 0.002 in series); mesh K = 1e4 N m/rad, e = 0.8 (the defaults). Calibrated step "
-        f"{cal.model.opt.timestep:g} s, recipe step {rec.model.opt.timestep:g} s (the model's).",
+        f"{cal.model.opt.timestep:g} s, exact step {ex.model.opt.timestep:g} s (the same rule), recipe step "
+        f"{rec.model.opt.timestep:g} s (the model's).",
         "",
-        "| closing speed [rad/s] | law peak [N m] | calibrated peak | error | recipe peak | error | law e | "
-        "calibrated e | error | recipe e | error |",
-        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| closing speed [rad/s] | law peak [N m] | calibrated peak | error | exact peak | error | recipe peak | error "
+        "| law e | calibrated e | error | exact e | error | recipe e | error |",
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|",
     ]
     table = []
     for v in np.geomspace(0.2, 2.0, 5):
@@ -185,18 +193,20 @@ def _flywheel_section() -> list[str]:
         )
         cp, ce = flywheel_impact(cal.model, float(v))
         rp, re = flywheel_impact(rec.model, float(v))
-        table.append((float(v), law.peak_force, cp, rp, law.restitution, ce, re))
+        xp, xe = flywheel_impact(ex.model, float(v))
+        table.append((float(v), law.peak_force, cp, rp, law.restitution, ce, re, xp, xe))
         lines.append(
-            f"| {v:.3g} | {law.peak_force:.4g} | {cp:.4g} | {100 * (cp / law.peak_force - 1):+.2f} % | {rp:.4g} | "
-            f"{100 * (rp / law.peak_force - 1):+.1f} % | {law.restitution:.4f} | {ce:.4f} | "
-            f"{100 * (ce / law.restitution - 1):+.2f} % | {re:.4f} | {100 * (re / law.restitution - 1):+.1f} % |"
+            f"| {v:.3g} | {law.peak_force:.4g} | {cp:.4g} | {100 * (cp / law.peak_force - 1):+.2f} % | {xp:.4g} | "
+            f"{100 * (xp / law.peak_force - 1):+.2f} % | {rp:.4g} | {100 * (rp / law.peak_force - 1):+.1f} % | "
+            f"{law.restitution:.4f} | {ce:.4f} | {100 * (ce / law.restitution - 1):+.2f} % | {xe:.4f} | "
+            f"{100 * (xe / law.restitution - 1):+.2f} % | {re:.4f} | {100 * (re / law.restitution - 1):+.1f} % |"
         )
     _figure(np.array(table))
     return lines + ["", f"![peak torque and restitution against closing speed]({FIGURE.name})"]
 
 
 def _figure(table: np.ndarray) -> None:
-    """Peak torque and restitution against closing speed: the law, the calibrated stop, the recipe."""
+    """Peak torque and restitution against closing speed: the law, the calibrated and exact stops, the recipe."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
     from matplotlib.ticker import NullFormatter
@@ -205,9 +215,10 @@ def _figure(table: np.ndarray) -> None:
     FigureCanvasAgg(fig)
     ax1, ax2 = fig.subplots(1, 2)
     v = table[:, 0]
-    for col, label, style in ((1, "law (LN, n = 1)", "k-"), (2, "calibrated stop", "o"), (3, "recipe (defaults)", "s")):
+    styles = (("law (LN, n = 1)", "k-"), ("calibrated stop", "o"), ("exact stop", "x"), ("recipe (defaults)", "s"))
+    for col, (label, style) in zip((1, 2, 7, 3), styles):
         ax1.loglog(v, table[:, col], style, label=label, mfc="none")
-    for col, label, style in ((4, "law (LN, n = 1)", "k-"), (5, "calibrated stop", "o"), (6, "recipe (defaults)", "s")):
+    for col, (label, style) in zip((4, 5, 8, 6), styles):
         ax2.semilogx(v, table[:, col], style, label=label, mfc="none")
     ax1.set(xlabel="closing speed [rad/s]", ylabel="peak stop torque [N m]", title="peak torque")
     ax2.set(xlabel="closing speed [rad/s]", ylabel="restitution [-]", title="rebound", ylim=(0, 1))
