@@ -201,3 +201,17 @@ def test_a_retrofit_folder_opens_its_model_and_with_ideal_its_unmodified_twin(tm
     assert model.nq == 2 and data.qpos[0] == pytest.approx(0.3, abs=0)  # keyframe 0 applied exactly
     model, data = initial_state(tmp_path, ideal=True)
     assert model.nq == 1 and data.qpos[0] == pytest.approx(0.3, abs=0)
+
+
+@pytest.mark.parametrize("plugin", [cp.PLUGIN_NAME, "clearance.backlash_stop"])
+def test_a_plugin_model_without_the_library_says_how_to_install(capsys, monkeypatch, ring_file, plugin):
+    """Either plugin's model, on an installation without the library, gets the install advice."""
+
+    def unknown_plugin(path):
+        raise ValueError(f"Error: unknown plugin '{plugin}'")  # MuJoCo's words for a plugin nobody registered
+
+    monkeypatch.setattr(cp, "is_available", lambda: False)
+    monkeypatch.setattr(mujoco.MjModel, "from_xml_path", staticmethod(unknown_plugin))
+    assert main(["view", str(ring_file)]) == 2
+    err = capsys.readouterr().err
+    assert "not available" in err and err.count("\n") == 1, err

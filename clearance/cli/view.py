@@ -104,18 +104,20 @@ def initial_state(path: str | os.PathLike[str], *, ideal: bool = False) -> tuple
     Raises:
         ValueError: see `model_path`; or the XML does not compile (MuJoCo's message, on one line).
         clearance.contact_plugin.PluginUnavailableError: the model uses the compiled contact
-            and this installation has no plugin library.
+            (a journal bearing or an exact backlash stop) and this installation has no plugin
+            library.
     """
     import mujoco
 
     from clearance.contact_plugin import PLUGIN_NAME, PluginUnavailableError, is_available, load
+    from clearance.contact_plugin.backlash_stop import PLUGIN_NAME as STOP_PLUGIN_NAME
 
     file = model_path(path, ideal=ideal)
     load()
     try:
         model = mujoco.MjModel.from_xml_path(str(file))
     except ValueError as err:
-        if PLUGIN_NAME in str(err) and not is_available():
+        if any(name in str(err) for name in (PLUGIN_NAME, STOP_PLUGIN_NAME)) and not is_available():
             raise PluginUnavailableError() from None
         message = " ".join(line.strip() for line in str(err).splitlines() if line.strip())
         raise ValueError(f"clearance view: {file} does not compile in MuJoCo: {message}") from None
