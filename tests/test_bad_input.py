@@ -496,6 +496,22 @@ def test_scheduler_without_dask_names_the_install_command(command, tmp_path, mon
     assert not out.exists()
 
 
+def test_an_unreachable_scheduler_is_one_line_after_the_stated_wait(tmp_path, capsys):
+    from clearance.analysis.sweeps.executor import SCHEDULER_TIMEOUT
+
+    pytest.importorskip("dask.distributed")
+    out = tmp_path / "s"
+    argv = ["sweep", "--points", "1", "--start", "0.5", "--stop", "0.5", "--periods", "2", "--sampled", "1"]
+    argv += ["--out", str(out)]
+    t0 = time.perf_counter()
+    rc, _, err = _call([*argv, "--scheduler", "tcp://127.0.0.1:9", "--no-progress"], capsys)  # port 9: nobody listens
+    elapsed = time.perf_counter() - t0
+    assert rc == 2 and "Traceback" not in err, err
+    assert "--scheduler tcp://127.0.0.1:9" in err and "cannot reach the Dask scheduler" in err, err
+    # refused after the stated wait, not Dask's own 30 s; 10 s more covers the sweep's imports and preparation
+    assert elapsed < SCHEDULER_TIMEOUT + 10, elapsed
+
+
 def test_scenario_builder_sizes_out_of_range_are_refused_naming_the_key():
     """Every catalogue builder argument with a unit, at 1e-300 and 1e300 in its first unit: a
     ScenarioError naming the key (or a builder's own refusal), never ZeroDivisionError or

@@ -31,6 +31,7 @@ if TYPE_CHECKING:
 
 __all__ = [
     "PARENT_POLL_S",
+    "SCHEDULER_TIMEOUT",
     "DASK_INSTALL",
     "Pool",
     "Progress",
@@ -45,6 +46,11 @@ PARENT_POLL_S = 0.2
 
 DASK_INSTALL = "pip install 'dask[distributed]'"
 """The command that installs what a Dask scheduler address needs."""
+
+
+SCHEDULER_TIMEOUT = 5.0
+"""How long a Dask scheduler is waited for before it counts as unreachable [s] (Dask's own
+default is 30 s; a scheduler on the network answers within milliseconds)."""
 
 
 class SchedulerError(RuntimeError):
@@ -123,7 +129,7 @@ def open_executor(
         from dask.distributed import Client
 
         try:
-            client = Client(scheduler_address)
+            client = Client(scheduler_address, timeout=f"{SCHEDULER_TIMEOUT}s")
         except (OSError, TimeoutError, ValueError) as err:
             raise SchedulerError(f"cannot reach the Dask scheduler at {scheduler_address!r}: {err}") from None
         try:
