@@ -117,3 +117,13 @@ def test_the_pusher_with_backlash_at_every_actuated_hinge_runs_a_second(tmp_path
     assert [r["hinge"] for r in rows] == hinges and len(hinges) == 7
     assert all(int(r["impacts"]) > 0 and float(r["peak_torque"]) > 0 for r in rows)
     assert stdout.count("peak stop torque") == 7
+
+
+def test_without_site_the_end_effector_is_reported(folder, tmp_path, capsys):
+    out = tmp_path / "run"
+    code = main(["run", "--model", str(folder), "--duration-ms", "20", "--out", str(out)])
+    stdout = capsys.readouterr().out
+    assert code == 0
+    # the reacher's deepest named body below joint0 and joint1 is its fingertip
+    assert "fingertip: deviation from the twin up to" in stdout and "the end effector by default" in stdout
+    assert (out / "site_deviation.csv").is_file()

@@ -81,7 +81,8 @@ def backlash_section(out: str | Path, result: SimulationResult, rows: list[Backl
         "## Backlash at the actuated hinges",
         "",
         "Backlash angle q_load - q_motor (the dead band's tendon); an impact is an onset of the stop's torque (the "
-        "tendon limit's constraint torque) at either end of the band.",
+        "tendon limit's constraint torque for a calibrated or recipe stop, the mesh law's torque from the "
+        "`clearance.backlash_stop` plugin for an exact stop; `retrofit.md` says which) at either end of the band.",
         "",
         "| hinge | b [arcmin] | angle range [arcmin] | impacts (+b / -b) | peak stop torque [N m] | at [ms] "
         "| at the stop |",

@@ -10,7 +10,8 @@ or the sinusoid the retrofit was sized from (default). The run's arrays go to
 ``result.npz/json``, the twin's to ``ideal.npz/json``, with ``summary.csv`` (contact
 statistics per hinge; for a backlash retrofit ``backlash_summary.csv``: per hinge the angle's
 range in the band, the impacts at its ends and the peak stop torque), ``site_deviation.csv``
-(with ``--site``) and ``report.md`` with its
+(of ``--site``, by default the named body deepest below the retrofitted hinges: the end
+effector) and ``report.md`` with its
 figures (`clearance.analysis.figures.model_report`); ``--rerun`` also records the bodies of
 both models moving in 3-D with the orbits beside them (`clearance.analysis.recording.model_rerun`).
 """
@@ -87,7 +88,8 @@ def add_model_args(r: argparse.ArgumentParser) -> None:
         "--site",
         default=None,
         metavar="NAME",
-        help="a site (or body) whose deviation from the twin's is reported (an end effector)",
+        help="a site (or body) whose deviation from the twin's is reported (an end effector; default the named "
+        "body deepest below the retrofitted hinges)",
     )
 
 
@@ -112,6 +114,26 @@ def uses_model(args: argparse.Namespace) -> bool:
     return True
 
 
+def _default_site(loaded: Retrofitted) -> list[str]:
+    """The end effector a run reports without ``--site``: the named body deepest below the
+    retrofitted hinges (as `clearance rank --model` scores); [] where there is none (a loop
+    closure's connect alone, or no named body below)."""
+    import mujoco
+
+    from clearance.retrofit import RetrofitError
+    from clearance.run.play_candidates import end_effector
+
+    twin, m = loaded.twin, loaded.manifest
+    names = [r.name for r in (*m.hinges, *m.backlash)]
+    joints = [n for n in names if mujoco.mj_name2id(twin, mujoco.mjtObj.mjOBJ_JOINT, n) >= 0]
+    if not joints:
+        return []
+    try:
+        return [end_effector(twin, joints)]
+    except RetrofitError:
+        return []
+
+
 def model_command(args: argparse.Namespace) -> int:
     """Run ``clearance run --model DIR``; returns the exit status (2: refused or stopped by an error)."""
     from clearance.cli.outputs import check_output_paths
@@ -128,7 +150,7 @@ def model_command(args: argparse.Namespace) -> int:
     else:
         amplitude = 0.5 if args.sine_amplitude is None else args.sine_amplitude
         drive = SineControl(amplitude, 1.0 if args.sine_frequency_hz is None else args.sine_frequency_hz)
-    sites = [args.site] if args.site else []
+    sites = [args.site] if args.site else _default_site(loaded)
     loaded.check_sites(sites)
     duration = si(args.duration_ms if args.duration_ms else DEFAULT_DURATION_MS, "ms")
     source = f"--duration-ms {args.duration_ms:g}" if args.duration_ms else f"the default {DEFAULT_DURATION_MS:g} ms"
@@ -211,6 +233,7 @@ def _run(
         axes = ", ".join(f"{k.rsplit('/', 1)[1]} {s.rms_deviation * 1e3:.3g}" for k, s in deviation.axes.items())
         print(
             f"  {deviation.site}: deviation from the twin up to {deviation.max_distance * 1e3:.3g} mm; RMS [mm] {axes}"
+            + ("" if args.site else " (the end effector by default: --site to choose another point)")
         )
     print(f"  {result.metadata['steps_per_second']:.3g} steps/s; wrote {out}/")
     if failed is not None:
