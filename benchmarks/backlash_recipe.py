@@ -71,6 +71,26 @@ def _limit_rows(data: mujoco.MjData) -> dict[int, float]:
     return {int(data.efc_id[i]): float(data.efc_force[i]) for i in range(data.nefc) if data.efc_type[i] == LIMIT}
 
 
+def _stop_sensors(model: mujoco.MjModel, hinges: list[str]) -> list[int]:
+    """Per band, the address of its exact stop's plugin sensor, or -1 for a tendon-limit stop."""
+    ids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, stop_plugin_name(h)) for h in hinges]
+    return [int(model.sensor_adr[i]) if i >= 0 else -1 for i in ids]
+
+
+def _band_torques(data: mujoco.MjData, tendons: list[int], sensors: list[int]) -> dict[int, float]:
+    """Band index -> its stop's torque [N m], for the bands at their stop: a tendon limit's row force, or an
+    exact stop's plugin torque while its penetration (the sensor's third value) is positive."""
+    limits = _limit_rows(data)
+    out = {}
+    for k, (t, adr) in enumerate(zip(tendons, sensors, strict=True)):
+        if adr >= 0:
+            if data.sensordata[adr + 2] > 0:
+                out[k] = float(data.sensordata[adr])
+        elif t in limits:
+            out[k] = limits[t]
+    return out
+
+
 def flywheel_impact(model: mujoco.MjModel, speed: float) -> tuple[float, float]:
     """(peak stop torque [N m], restitution [-]) of the flywheel's load closing on the stop at ``speed``.
 
@@ -78,13 +98,12 @@ def flywheel_impact(model: mujoco.MjModel, speed: float) -> tuple[float, float]:
     """
     d = mujoco.MjData(model)
     load, motor = model.joint("shaft").dofadr[0], model.joint("shaft__motor").dofadr[0]
-    exact = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, stop_plugin_name("shaft"))
-    adr = int(model.sensor_adr[exact]) if exact >= 0 else -1
+    tendons, sensors = [int(model.tendon("clr_shaft__backlash").id)], _stop_sensors(model, ["shaft"])
     d.qvel[load] = speed
     peak, touched = 0.0, False
     for _ in range(int(50 * FLYWHEEL_B / speed / model.opt.timestep) + 2000):
         mujoco.mj_step(model, d)
-        rows = _limit_rows(d) if adr < 0 else ({0: float(d.sensordata[adr])} if d.sensordata[adr + 2] > 0 else {})
+        rows = _band_torques(d, tendons, sensors)
         if rows:
             touched = True
             peak = max(peak, *rows.values())
@@ -118,6 +137,7 @@ def motion(
     n = int(round(1.0 / timestep))
     u = control_signal(m, SineControl(), np.arange(n) * timestep)
     tendons = [int(m.tendon(h.tendon).id) for h in out.hinges.values()]
+    sensors = _stop_sensors(m, list(out.hinges))
     b = np.array([h.backlash.half_width for h in out.hinges.values()])
     d, dt = initial_data(m), initial_data(twin)
     peak, widest = np.zeros(len(tendons)), np.zeros(len(tendons))
@@ -130,11 +150,11 @@ def motion(
     for i in range(n):
         d.ctrl[:] = u[i]
         mujoco.mj_step(m, d)
-        rows = _limit_rows(d)
+        rows = _band_torques(d, tendons, sensors)
         for k, t in enumerate(tendons):
             rate = abs(float(d.ten_velocity[t]))
-            if t in rows:
-                peak[k] = max(peak[k], rows[t])
+            if k in rows:
+                peak[k] = max(peak[k], rows[k])
                 if closing[k] is None:
                     closing[k] = rate
                     impacts[k] += 1
@@ -275,10 +295,14 @@ def _motion_section() -> list[str]:
         t0 = time.perf_counter()
         rec = add_backlash(spec, {h: Backlash(b, stop="recipe") for h in names})
         t_rec = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        ex = add_backlash(spec, {h: Backlash(b, stop="exact") for h in names})
+        t_ex = time.perf_counter() - t0
         runs = [
             ("recipe", rec, float(plain.opt.timestep), t_rec),
             ("recipe", rec, float(cal.model.opt.timestep), t_rec),
             ("calibrated", cal, float(cal.model.opt.timestep), t_cal),
+            ("exact", ex, float(ex.model.opt.timestep), t_ex),
         ]
         for stop, out, h, t_build in runs:
             r = motion(out, h, point)
