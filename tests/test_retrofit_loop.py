@@ -184,3 +184,28 @@ def test_cli_retrofits_a_connect(tmp_path, capsys):
     assert "loop: c = 0.2 mm" in capsys.readouterr().out
     written = mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "model.xml"))  # stock MuJoCo opens it
     assert mujoco.mj_name2id(written, mujoco.mjtObj.mjOBJ_BODY, "clr_loop__pin") >= 0
+
+
+_TWO_PINS = """<mujoco model="two_pins"><option timestep="0.001"/><worldbody>
+<body name="link1"><joint name="h1" type="hinge" axis="0 0 1"/>
+<geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01" mass="0.5"/></body>
+<body name="link2" pos="0.4 0 0"><joint name="h2" type="hinge" axis="0 0 1"/>
+<geom type="capsule" fromto="0 0 0 -0.2 0 0" size="0.01" mass="0.5"/></body>
+<body name="link3" pos="0.2 0 0"><joint name="h3" type="hinge" axis="0 0 1"/>
+<geom type="capsule" fromto="0 0 0 0 0.1 0" size="0.01" mass="0.5"/></body></worldbody>
+<equality><connect name="c1" body1="link1" body2="link3" anchor="0.2 0 0"/>
+<connect name="c2" body1="link2" body2="link3" anchor="-0.2 0 0"/></equality>
+<actuator><motor joint="h1" gear="1" ctrlrange="-1 1"/></actuator></mujoco>"""
+
+
+@pytest.mark.parametrize("order", [["c2", "h3", "c1"], ["c2", "c1"], ["c1", "c2"]])
+def test_two_pins_on_one_body_in_any_order(order):
+    """Two connects closing on one body get their pins in the order given; the coordinate map follows it
+    (before, pins at one point of the joint order were mapped by name and the edit stopped on its own check)."""
+    numerics = RetrofitOptions(contact_mode="nominal", segments=64, sizing_duration=0.05, measure_speed=False)
+    r = retrofit(mujoco.MjSpec.from_string(_TWO_PINS), {name: RadialPlay() for name in order}, numerics)
+    m = r.model
+    pins = [n for n in order if n.startswith("c")]
+    joints = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(m.njnt)]
+    # each pin's slides follow link3's own joints (and h3's slides where h3 is retrofitted), in the order given
+    assert joints[-2 * len(pins) :] == [f"clr_{p}__{k}" for p in pins for k in ("x", "y")]

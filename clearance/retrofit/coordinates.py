@@ -78,11 +78,18 @@ def coordinate_map(
         twin: the unmodified model.
         hinges: hinge name -> its joint id in ``twin``.
         pins: loop closure name -> the joint id in ``twin`` its pin's slides come before
-            (``njnt``: at the end; `clearance.retrofit.loop.pin_insertion_joint`).
+            (``njnt``: at the end; `clearance.retrofit.loop.pin_insertion_joint`), in the order
+            the pins were added to the spec (pins on one body follow one another in that order).
     """
-    inserts = sorted(
-        [(j, 1, n) for n, j in hinges.items()] + [(j, 0, n) for n, j in (pins or {}).items()],
-    )
+    # at one joint a pin's slides come before a hinge's; pins at one joint (the same body2) in the
+    # order they were added (the mappings' order), not by name
+    inserts = [
+        (j, kind, name)
+        for j, kind, _, name in sorted(
+            [(j, 1, k, n) for k, (n, j) in enumerate(hinges.items())]
+            + [(j, 0, k, n) for k, (n, j) in enumerate((pins or {}).items())]
+        )
+    ]
     qpos = np.zeros(twin.nq, dtype=int)
     qvel = np.zeros(twin.nv, dtype=int)
     for j in range(twin.njnt):
