@@ -369,7 +369,7 @@ def add_sweep_args(p: argparse.ArgumentParser, command: str) -> None:
         "--stop-after",
         type=positive(int, "--stop-after"),
         default=None,
-        help="stop after this many points (resume later)",
+        help="stop after this many points (for allocate: simulated runs); rerun the command to resume",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 
