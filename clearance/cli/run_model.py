@@ -124,7 +124,7 @@ def _default_site(loaded: Retrofitted) -> list[str]:
     from clearance.run.play_candidates import end_effector
 
     twin, m = loaded.twin, loaded.manifest
-    names = [r.name for r in (*m.hinges, *m.backlash)]
+    names = [h.name for h in m.hinges] + [b.name for b in m.backlash]
     joints = [n for n in names if mujoco.mj_name2id(twin, mujoco.mjtObj.mjOBJ_JOINT, n) >= 0]
     if not joints:
         return []
