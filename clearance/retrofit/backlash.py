@@ -40,6 +40,7 @@ from clearance.contact_calibration.torsional_stop import OMEGA_H
 from clearance.contact_plugin import require
 from clearance.contact_plugin.backlash_stop import add_backlash_stop
 from clearance.retrofit.backlash_stop import Band, BandStop, calibrate_stops
+from clearance.retrofit.coordinates import joint_index_map
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.play import PREFIX, Backlash, RetrofitError
 from clearance.retrofit.selection import check_not_retrofitted, compile_model, model_label
@@ -66,18 +67,6 @@ _HINGE = mujoco.mjtJoint.mjJNT_HINGE
 _ACTUATOR_SENSORS = (mujoco.mjtSensor.mjSENS_JOINTACTFRC,)
 _STATE_SENSORS = (mujoco.mjtSensor.mjSENS_JOINTPOS, mujoco.mjtSensor.mjSENS_JOINTVEL)
 _TRN_JOINT = (int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT))
-_QPOS_WIDTH = {
-    mujoco.mjtJoint.mjJNT_FREE: 7,
-    mujoco.mjtJoint.mjJNT_BALL: 4,
-    mujoco.mjtJoint.mjJNT_SLIDE: 1,
-    mujoco.mjtJoint.mjJNT_HINGE: 1,
-}
-_DOF_WIDTH = {
-    mujoco.mjtJoint.mjJNT_FREE: 6,
-    mujoco.mjtJoint.mjJNT_BALL: 3,
-    mujoco.mjtJoint.mjJNT_SLIDE: 1,
-    mujoco.mjtJoint.mjJNT_HINGE: 1,
-}
 
 
 def motor_joint_name(hinge: str) -> str:
@@ -404,13 +393,7 @@ def _extend_keyframes(
 ) -> int:
     """Rewrite each keyframe's qpos and qvel for ``model``: the twin's values where its joints now
     sit, each motor angle and speed equal to its load's (the band centred). Returns the count."""
-    qmap: list[tuple[int, int, int]] = []  # (twin adr, model adr, width) for qpos
-    vmap: list[tuple[int, int, int]] = []
-    for jt, spec_joint in enumerate(old_joints):
-        jm = int(spec_joint.id)
-        kind = mujoco.mjtJoint(int(twin.jnt_type[jt]))
-        qmap.append((int(twin.jnt_qposadr[jt]), int(model.jnt_qposadr[jm]), _QPOS_WIDTH[kind]))
-        vmap.append((int(twin.jnt_dofadr[jt]), int(model.jnt_dofadr[jm]), _DOF_WIDTH[kind]))
+    qmap, vmap = joint_index_map(twin, model, [int(j.id) for j in old_joints])
     motors = [
         (int(model.jnt_qposadr[model.joint(h.name).id]), int(model.jnt_qposadr[model.joint(h.motor_joint).id]))
         for h in done.values()
@@ -422,10 +405,8 @@ def _extend_keyframes(
     for k, key in enumerate(work.keys):
         qpos = model.qpos0.copy()
         qvel = np.zeros(model.nv)
-        for a, b, n in qmap:
-            qpos[b : b + n] = twin.key_qpos[k, a : a + n]
-        for a, b, n in vmap:
-            qvel[b : b + n] = twin.key_qvel[k, a : a + n]
+        qpos[qmap] = twin.key_qpos[k]
+        qvel[vmap] = twin.key_qvel[k]
         for load, motor in motors:
             qpos[motor] = qpos[load]
         for load, motor in dmotors:

@@ -8,13 +8,13 @@ model becomes a state of the other.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
-__all__ = ["CoordinateMap", "coordinate_map", "check_map", "extend_keyframes"]
+__all__ = ["CoordinateMap", "coordinate_map", "check_map", "extend_keyframes", "joint_index_map"]
 
 _NQ = {
     mujoco.mjtJoint.mjJNT_FREE: 7,
@@ -108,6 +108,30 @@ def coordinate_map(
     return CoordinateMap(
         qpos, qvel, slide_qpos, slide_dof, int(twin.nq) + 2 * len(inserts), int(twin.nv) + 2 * len(inserts)
     )
+
+
+def joint_index_map(
+    twin: mujoco.MjModel, model: mujoco.MjModel, joints: Sequence[int]
+) -> tuple[np.ndarray, np.ndarray]:
+    """Where the unmodified coordinates sit in an edited model, read from its compiled joints.
+
+    Args:
+        twin: the unmodified model.
+        model: the edited model.
+        joints: for each joint of ``twin`` in order, its id in ``model``.
+
+    Returns:
+        (qpos, qvel): index in ``model``'s qpos / qvel of each of ``twin``'s entries.
+    """
+    qpos = np.zeros(twin.nq, dtype=int)
+    qvel = np.zeros(twin.nv, dtype=int)
+    for jt, jm in enumerate(joints):
+        kind = mujoco.mjtJoint(int(twin.jnt_type[jt]))
+        a, b = int(twin.jnt_qposadr[jt]), int(model.jnt_qposadr[jm])
+        qpos[a : a + _NQ[kind]] = np.arange(b, b + _NQ[kind])
+        a, b = int(twin.jnt_dofadr[jt]), int(model.jnt_dofadr[jm])
+        qvel[a : a + _NV[kind]] = np.arange(b, b + _NV[kind])
+    return qpos, qvel
 
 
 def check_map(cmap: CoordinateMap, model: mujoco.MjModel, slides: Mapping[str, tuple[str, str]]) -> None:
