@@ -40,7 +40,7 @@ import numpy as np
 from clearance.analysis.metrics.site_deviation import site_deviation
 from clearance.analysis.sweeps.criticality import CriticalityRanking, rank_joints
 from clearance.analysis.sweeps.executor import Progress, open_executor
-from clearance.analysis.sweeps.sweep import load_rows
+from clearance.analysis.sweeps.sweep import check_manifest, load_rows
 from clearance.results import SimulationResult, atomic_write_text
 
 __all__ = [
@@ -250,24 +250,6 @@ def rank_plays(rows: Sequence[Mapping[str, Any]], *, site: str, startup: float) 
     return RobotRanking(by_kind, overall, cells, sizes, site, startup, failed)
 
 
-def _check_folder(out: Path, manifest: dict[str, Any]) -> None:
-    path = out / _MANIFEST
-    if path.exists():
-        try:
-            old = json.loads(path.read_text(encoding="utf-8"))
-        except ValueError as err:
-            raise ValueError(
-                f"{path} is unreadable ({err}): delete {out} to start over, or use another folder"
-            ) from None
-        if old != manifest:
-            what = "points" if old.get("points") != manifest["points"] else "settings"
-            raise ValueError(
-                f"{out} holds a different ranking (its {what} differ; see {path}): use another --out or delete it"
-            )
-    else:
-        atomic_write_text(path, json.dumps(manifest, indent=1))
-
-
 def run_robot_ranking(
     runner: PlayRunner,
     points: Sequence[Mapping[str, Any]],
@@ -299,7 +281,8 @@ def run_robot_ranking(
         raise ValueError("a ranking needs at least one point")
     out = Path(out_dir)
     (out / "points").mkdir(parents=True, exist_ok=True)
-    _check_folder(out, {"points": pts, "settings": {"runner": repr(runner), "site": site, "startup": startup}})
+    settings = {"runner": repr(runner), "site": site, "startup": startup}
+    check_manifest(out, pts, settings, file=_MANIFEST, kind="ranking")
     rows = {r["index"]: r for r in load_rows(out) if 0 <= r["index"] < len(pts)}
     todo = [i for i in range(len(pts)) if i not in rows]
     with (

@@ -51,6 +51,7 @@ __all__ = [
     "MechanismFactory",
     "SweepEvaluation",
     "SweepOutcome",
+    "check_manifest",
     "evaluate_point",
     "load_rows",
     "run_sweep",
@@ -331,15 +332,35 @@ _SETTING_NAMES = {
 }
 
 
-def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str, Any]) -> None:
-    path = out / "sweep.json"
+def check_manifest(
+    out: Path,
+    points: list[dict[str, Any]],
+    settings: dict[str, Any],
+    *,
+    file: str = "sweep.json",
+    kind: str = "sweep",
+) -> None:
+    """Record which points and settings a resumable folder holds, or check that it holds these.
+
+    Args:
+        out: the folder (exists).
+        points: the points, in order.
+        settings: everything else that makes a point's result.
+        file: the manifest's file name in ``out``.
+        kind: what the folder holds, for messages ("sweep", "ranking").
+
+    Raises:
+        ValueError: the folder's manifest is unreadable or records other points or settings;
+            the message names what differs and how to go on.
+    """
+    path = out / file
     manifest = _json_safe({"points": points, "settings": settings})
     if path.exists():
         try:
             old = json.loads(path.read_text(encoding="utf-8"))
         except ValueError as err:
             raise ValueError(
-                f"{path} is unreadable ({err}); it records which sweep {out} holds, so its points cannot be "
+                f"{path} is unreadable ({err}); it records which {kind} {out} holds, so its points cannot be "
                 "reused safely: delete that folder to start over, or use another folder"
             ) from None
         if old != manifest:
@@ -352,7 +373,7 @@ def _check_manifest(out: Path, points: list[dict[str, Any]], settings: dict[str,
             if old.get("points") != manifest["points"]:
                 diffs.insert(0, f"points: {len(old.get('points', []))} there, {len(points)} now or values differ")
             raise ValueError(
-                f"{out} holds a different sweep ({'; '.join(diffs) or 'manifest differs'}; see {path}); "
+                f"{out} holds a different {kind} ({'; '.join(diffs) or 'manifest differs'}; see {path}); "
                 "use another out_dir or delete that folder"
             )
     else:
@@ -415,7 +436,7 @@ def run_sweep(
         "options": repr(options),
         "evaluation": _describe(evaluation),
     }
-    _check_manifest(out, _json_safe(pts), settings)
+    check_manifest(out, _json_safe(pts), settings)
     rows = {r["index"]: r for r in load_rows(out) if 0 <= r["index"] < len(pts)}
     todo = [i for i in range(len(pts)) if i not in rows]
     csv_path = out / "sweep.csv"
