@@ -109,14 +109,19 @@ class BandStop:
     pose_rows: tuple[StopRow, ...] = ()
 
 
-def _inverse_mass_along(model: mujoco.MjModel, band: Band) -> np.ndarray:
-    """M⁻¹ J_tᵀ at qpos0 for the band's tendon (+1 on the load dof, -1 on the motor dof)."""
-    data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
+def _band_jacobian(model: mujoco.MjModel, band: Band) -> np.ndarray:
+    """J_t of the band's tendon q_load - q_motor: +1 on the load dof, -1 on the motor dof."""
     jac = np.zeros(model.nv)
     jac[band.load_dof], jac[band.motor_dof] = 1.0, -1.0
+    return jac
+
+
+def _inverse_mass_along(model: mujoco.MjModel, band: Band) -> np.ndarray:
+    """M⁻¹ J_tᵀ at qpos0 for the band's tendon."""
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
     out = np.zeros(model.nv)
-    mujoco.mj_solveM(model, data, out.reshape(1, -1), jac.reshape(1, -1))
+    mujoco.mj_solveM(model, data, out.reshape(1, -1), _band_jacobian(model, band).reshape(1, -1))
     return out
 
 
@@ -128,11 +133,7 @@ def pose_inertias(model: mujoco.MjModel, bands: Mapping[str, Band]) -> dict[str,
         (int(model.jnt_qposadr[model.dof_jntid[b.load_dof]]), int(model.jnt_qposadr[model.dof_jntid[b.motor_dof]]))
         for b in bands.values()
     ]
-    jacs = []
-    for b in bands.values():
-        jac = np.zeros(model.nv)
-        jac[b.load_dof], jac[b.motor_dof] = 1.0, -1.0
-        jacs.append(jac)
+    jacs = [_band_jacobian(model, b) for b in bands.values()]
     seen = np.zeros((POSE_SAMPLES + 1, len(jacs)))
     x = np.zeros((1, model.nv))
     for i in range(POSE_SAMPLES + 1):
