@@ -321,24 +321,9 @@ class SimulationResult:
             body_poses=cat([p.body_poses for p in parts]) if len(first.body_poses) else first.body_poses,
         )
 
-    # -- persistence --------------------------------------------------------------------
-    def save(self, path: str | os.PathLike, *, compress: bool = False) -> tuple[Path, Path]:
-        """Save to ``<stem>.npz`` and ``<stem>.json``; returns both paths.
-
-        The energy series go into the ``.npz`` (``energy/<term>``); with them, the JSON's
-        ``energy_balance`` is the summary of the saved rows (`energy_balance`), written even if
-        the metadata in memory has none.
-
-        Args:
-            path: file path; any suffix is replaced.
-            compress: deflate the arrays (`numpy.savez_compressed`). The default run's two files
-                then take 4.3 MB instead of 7.4 MB, but 0.23 s to write instead of 4 ms (numpy 2.4,
-                benchmarks/startup_time.md), so runs are saved as they are and stores of many runs
-                (`clearance.analysis.sweeps.run_store`) compress. `load` reads either.
-        """
-        import io
-
-        stem = Path(path).with_suffix("")
+    def arrays(self) -> dict[str, np.ndarray]:
+        """Every series of the result by its name in the saved ``.npz`` (``times``,
+        ``output/<name>``, ``joint/<joint>/<field>``, ``energy/<term>``, ``reaction/<joint>``, ...)."""
         arrays: dict[str, np.ndarray] = {
             "times": self.times,
             "drive_angle": self.drive_angle,
@@ -358,6 +343,27 @@ class SimulationResult:
             arrays[f"reaction/{k}"] = v
         if len(self.body_poses):
             arrays["body_poses"] = self.body_poses
+        return arrays
+
+    # -- persistence --------------------------------------------------------------------
+    def save(self, path: str | os.PathLike, *, compress: bool = False) -> tuple[Path, Path]:
+        """Save to ``<stem>.npz`` and ``<stem>.json``; returns both paths.
+
+        The energy series go into the ``.npz`` (``energy/<term>``); with them, the JSON's
+        ``energy_balance`` is the summary of the saved rows (`energy_balance`), written even if
+        the metadata in memory has none.
+
+        Args:
+            path: file path; any suffix is replaced.
+            compress: deflate the arrays (`numpy.savez_compressed`). The default run's two files
+                then take 4.3 MB instead of 7.4 MB, but 0.23 s to write instead of 4 ms (numpy 2.4,
+                benchmarks/startup_time.md), so runs are saved as they are and stores of many runs
+                (`clearance.analysis.sweeps.run_store`) compress. `load` reads either.
+        """
+        import io
+
+        stem = Path(path).with_suffix("")
+        arrays = self.arrays()
         buf = io.BytesIO()
         # numpy's stubs type **kwds against the allow_pickle keyword (absent before numpy 2.1) too
         (np.savez_compressed if compress else np.savez)(buf, **arrays)  # type: ignore[arg-type]

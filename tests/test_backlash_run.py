@@ -8,10 +8,12 @@ from __future__ import annotations
 import csv
 import json
 import math
+from functools import partial
 
 import mujoco
 import numpy as np
 import pytest
+from chunking import assert_chunking_is_invisible
 from gym_assets import gym_model
 
 from clearance.cli import main
@@ -127,3 +129,11 @@ def test_without_site_the_end_effector_is_reported(folder, tmp_path, capsys):
     # the reacher's deepest named body below joint0 and joint1 is its fingertip
     assert "fingertip: deviation from the twin up to" in stdout and "the end effector by default" in stdout
     assert (out / "site_deviation.csv").is_file()
+
+
+def test_chunked_and_thinned_runs_of_the_retrofit_and_its_twin_are_one_run_bitwise(folder):
+    # backlash (tendon limit rows): chunks carry the state and the solver's warm start (tests/test_chunked_runs.py)
+    loaded = load_retrofitted(folder)
+    h = loaded.manifest.timestep
+    for twin in (False, True):
+        assert_chunking_is_invisible(partial(simulate_retrofitted, loaded, SineControl(0.5, 2.0), twin=twin), h, 3000)

@@ -8,10 +8,12 @@ from __future__ import annotations
 
 import json
 import shutil
+from functools import partial
 
 import mujoco
 import numpy as np
 import pytest
+from chunking import assert_chunking_is_invisible
 from cli_runner import run_cli as _cli
 from gym_assets import gym_model
 
@@ -274,3 +276,15 @@ def test_exact_mode_retrofit_runs_with_the_compiled_contact(tmp_path):
         # frictionless: the force on the journal points to the bearing centre
         e = j.eccentricity[k] / np.hypot(*j.eccentricity[k])
         assert j.contact_force[k] @ e == pytest.approx(-j.force_magnitude[k], rel=1e-9)
+
+
+def test_chunked_and_thinned_runs_of_the_retrofit_and_its_twin_are_one_run_bitwise(folder):
+    # radial play (ring contact rows): chunks carry the state and the solver's warm start (tests/test_chunked_runs.py)
+    loaded = load_retrofitted(folder)
+    h = loaded.manifest.timestep
+    for twin in (False, True):
+        assert_chunking_is_invisible(
+            partial(simulate_retrofitted, loaded, SineControl(0.5, 2.0), sites=["fingertip"], twin=twin),
+            h,
+            3000,
+        )

@@ -51,12 +51,21 @@ def _exact_contact_force(sens: np.ndarray, at: dict[str, int], e: np.ndarray) ->
     return -fn[:, None] * n + ft[:, None] * t
 
 
-def _angle(xaxis: np.ndarray) -> np.ndarray:
-    return np.unwrap(np.arctan2(xaxis[:, 1], xaxis[:, 0]))
+def _angle(xaxis: np.ndarray, before: float | None) -> np.ndarray:
+    """Unwrapped angle of a body's x axis [rad], continuing from ``before`` (the row before, unwrapped)."""
+    angle = np.arctan2(xaxis[:, 1], xaxis[:, 0])
+    if before is None:
+        return np.unwrap(angle)
+    return np.unwrap(np.concatenate([[before], angle]))[1:]
 
 
 def read_sensors(
-    prepared: PreparedModel, times: np.ndarray, sens: np.ndarray, states: np.ndarray | None = None
+    prepared: PreparedModel,
+    times: np.ndarray,
+    sens: np.ndarray,
+    states: np.ndarray | None = None,
+    *,
+    angles_before: np.ndarray | None = None,
 ) -> SimulationResult:
     """Build a result from sensor rows of shape (n, nsensordata) at ``times`` (n,) [s].
 
@@ -71,6 +80,9 @@ def read_sensors(
             they give the drives' end-of-step velocities (module docstring). Without them the
             next sensor row stands in, and the last row keeps the step-start force with no
             armature correction.
+        angles_before: (n_links,) the links' unwrapped angles [rad] in the row before ``times[0]``
+            (the previous chunk's last row), so that a chunked run's angles continue across
+            chunk boundaries as one run's do; None: the first chunk.
     """
     mech, model = prepared.mechanism, prepared.model
     if prepared.slices is None:
@@ -85,7 +97,7 @@ def read_sensors(
     poses = np.empty((n, len(links), 3))
     for i, lk in enumerate(links):
         poses[:, i, :2] = get(f"{lk.name}__pos")[:, :2]
-        poses[:, i, 2] = _angle(get(f"{lk.name}__xaxis"))
+        poses[:, i, 2] = _angle(get(f"{lk.name}__xaxis"), None if angles_before is None else angles_before[i])
 
     outputs: dict[str, np.ndarray] = {}
     for o in mech.outputs:

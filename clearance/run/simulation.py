@@ -157,6 +157,7 @@ def simulate_prepared(
     constant = _constant_controls(mech)
     bar = _progress(progress, nstep)
     parts: list[SimulationResult] = []
+    angles: np.ndarray | None = None  # the links' unwrapped angles in the last full-rate row
     t0 = _time.perf_counter()
     done = 0
     while done < nstep:
@@ -168,7 +169,9 @@ def simulate_prepared(
             states, sens, data = step(ctrl, n)
         except _StepFailure as fail:
             states, sens, data, failure = fail.states, fail.sens, fail.data, fail.reason
-        part = read_sensors(prepared, times[: len(sens)], sens, states[: len(sens)])
+        part = read_sensors(prepared, times[: len(sens)], sens, states[: len(sens)], angles_before=angles)
+        if len(part):
+            angles = part.link_poses[-1, :, 2]
         # a stepper that stopped early has placed its warning at the step: only rows before it came back
         bad = _first_bad(prepared, data, part, states, sens, warnings=failure is None)
         if failure is not None and (bad is None or bad[0] >= len(sens)):
@@ -260,21 +263,27 @@ StepFailure = _StepFailure
 
 def model_stepper(model: mujoco.MjModel, data: mujoco.MjData) -> _Stepper:
     """Chunks of any model from ``data``'s state with `mujoco.rollout`; a chunk that raises a
-    MuJoCo warning stops at its first warning step with `StepFailure` (the rows before it)."""
+    MuJoCo warning stops at its first warning step with `StepFailure` (the rows before it).
+
+    Chunks equal one long rollout bit for bit by construction: each chunk starts from the
+    full-physics state and the constraint solver's warm start (``qacc_warmstart``, not part
+    of ``mjSTATE_FULLPHYSICS``) that the previous chunk ended with; a rollout given no warm
+    start would start every chunk's solver from zero.
+    """
     kind = mujoco.mjtState.mjSTATE_FULLPHYSICS
     state = np.empty(mujoco.mj_stateSize(model, kind))
     mujoco.mj_getState(model, data, state, kind)
-    box = {"state": state}
+    box = {"state": state, "warmstart": data.qacc_warmstart.copy()}
 
     def step(ctrl: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, mujoco.MjData]:
-        start, before = box["state"], _warning_count(data)
-        states, sens = rollout.rollout(model, data, start[None], ctrl[None], nstep=n)
+        start, warm, before = box["state"], box["warmstart"], _warning_count(data)
+        states, sens = rollout.rollout(model, data, start[None], ctrl[None], nstep=n, initial_warmstart=warm[None])
         states, sens = states[0], sens[0]
-        box["state"] = states[-1]
+        box["state"], box["warmstart"] = states[-1], data.qacc_warmstart.copy()
         if _warning_count(data) > before and np.isfinite(states).all() and np.isfinite(sens).all():
             # a warning without a non-finite value (a huge acceleration, a full contact
             # buffer) says nothing about when: step the chunk again to find the step
-            k, fired = _first_warning_step(model, start, ctrl, n)
+            k, fired = _first_warning_step(model, start, warm, ctrl, n)
             raise _StepFailure(states[:k], sens[:k], data, f"MuJoCo raised warnings {fired}")
         return states, sens, data
 
@@ -285,14 +294,17 @@ def _warning_count(data: mujoco.MjData) -> int:
     return int(sum(data.warning[i].number for i in range(mujoco.mjtWarning.mjNWARNING.value)))
 
 
-def _first_warning_step(model: mujoco.MjModel, state: np.ndarray, ctrl: np.ndarray, n: int) -> tuple[int, list[str]]:
+def _first_warning_step(
+    model: mujoco.MjModel, state: np.ndarray, warmstart: np.ndarray, ctrl: np.ndarray, n: int
+) -> tuple[int, list[str]]:
     """(index of the first step of a chunk that raises a MuJoCo warning, the warnings' names).
 
-    Replays the chunk from its initial full-physics state with `mujoco.mj_step` (the
-    stepping rollout does; only on this error path). ``ctrl``: (1, nu) held or (n, nu).
+    Replays the chunk from its initial full-physics state and warm start with `mujoco.mj_step`
+    (the stepping rollout does; only on this error path). ``ctrl``: (1, nu) held or (n, nu).
     """
     data = mujoco.MjData(model)
     mujoco.mj_setState(model, data, state, mujoco.mjtState.mjSTATE_FULLPHYSICS)
+    data.qacc_warmstart[:] = warmstart
     for k in range(n):
         data.ctrl[:] = ctrl[min(k, len(ctrl) - 1)]
         mujoco.mj_step(model, data)
