@@ -14,14 +14,15 @@ slot  field                  unit    meaning
 0     normal_force           N       F_n >= 0 of the contact law
 1     tangential_force       N       F_t on the journal along t = z x n (Ambrósio)
 2     penetration            m       δ = |e| − c (negative: gap)
-3     penetration_rate       m/s     δ̇ entering the law (> 0 approaching)
+3     penetration_rate       m/s     δ̇ entering the law (> 0 approaching): the step's mean rate
 4     approach_speed         m/s     δ̇⁻ of the current impact (0 out of contact)
 5     potential_energy       J       K δ^(n+1)/(n+1) for δ > 0, else 0
 6     dissipated_work        J       normal damping + friction work so far (>= 0)
 7     eccentricity           m       |e|, journal centre from bearing centre, in plane
 ====  =====================  ======  ====================================================
 
-Plugin state: `STATE_FIELDS`, 11 values per instance in ``mjData.plugin_state`` (part of
+Plugin state: `STATE_FIELDS` (9 values), then ``nv`` values (the last step's velocity change
+from every force but the joint's own), per instance in ``mjData.plugin_state`` (part of
 ``mjSTATE_PLUGIN``); see the C file's header for their use.
 """
 
@@ -44,6 +45,7 @@ __all__ = [
     "sensor_address",
     "sensor_offsets",
     "state_address",
+    "state_size",
 ]
 
 SENSOR_FIELDS: tuple[str, ...] = (
@@ -62,16 +64,15 @@ STATE_FIELDS: tuple[str, ...] = (
     "sample_time",
     "sample_penetration",
     "sample_rate",
-    "previous_sample_rate",
-    "sample_tangential_velocity",
-    "previous_sample_tangential_velocity",
-    "consecutive_samples",
+    "sample_friction_force",
+    "has_sample",
     "in_contact",
     "approach_speed",
     "dissipated_work",
     "steps",
 )
-"""Names of one instance's values in ``mjData.plugin_state``, in order."""
+"""Names of one instance's first values in ``mjData.plugin_state``, in order; ``nv`` more follow
+(`state_size`)."""
 
 _DISSIPATIVE = (
     ContactLaw.LANKARANI_NIKRAVESH,
@@ -317,6 +318,15 @@ def sensor_offsets(model: mujoco.MjModel, name: str) -> dict[str, int]:
     return {field: adr + k for k, field in enumerate(SENSOR_FIELDS)}
 
 
+def state_size(model: mujoco.MjModel) -> int:
+    """Values of one journal-bearing contact's state: `STATE_FIELDS`, then ``model.nv`` values.
+
+    Args:
+        model: a compiled model.
+    """
+    return len(STATE_FIELDS) + int(model.nv)
+
+
 def state_address(model: mujoco.MjModel, name: str) -> int:
     """Address of a journal-bearing contact's state in ``mjData.plugin_state``.
 
@@ -325,7 +335,7 @@ def state_address(model: mujoco.MjModel, name: str) -> int:
         name: the contact's name.
 
     Returns:
-        The index of `STATE_FIELDS[0]`; the block is 11 values long.
+        The index of `STATE_FIELDS[0]`; the block is `state_size` values long.
 
     Raises:
         ValueError: if the model has no such plugin instance.

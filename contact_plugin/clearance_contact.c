@@ -36,61 +36,74 @@
 // delta <= 0 (separation). The onset is located inside the step where delta crosses 0: delta is
 // taken as linear in time between the last recorded sample and the current one, giving the
 // crossing fraction theta = delta_prev / (delta_prev - delta), and the rate is interpolated
-// linearly in time at the crossing (see "In-step treatment" for the time the sampled rates are
-// read at). v_in = max(that rate, min_approach_speed). A contact present with no usable history
-// (first step after a reset, or a state set by hand) records max(delta_dot, min_approach_speed).
+// linearly in time at the crossing between the rates at the two samples' times (see "In-step
+// treatment" for those rates). v_in = max(that rate, min_approach_speed). A contact present with
+// no usable history (first step after a reset, or a state set by hand) records
+// max(delta_dot, min_approach_speed).
 //
-// In-step treatment. The force is explicit: it is evaluated once at the step's state (the
-// integrator's first force evaluation) and held over the step. MuJoCo's Euler, implicit,
-// implicitfast and discrete integrators are semi-implicit (velocities first, then positions with
-// the new velocities), which makes a sampled velocity lag its position by half a step (the
-// leapfrog reading: qvel_k is the velocity at t_k - h/2). Taken as it is, the damping term then
-// sees a stale rate and the first-impact peak force comes out high (+0.2..+1 % at 1 us, up to
-// +2..+6 % at 5 us). For those integrators the velocities entering the laws (the penetration
-// rate and the tangential velocity) are advanced by half a step with the changes of the last
-// recorded steps (x_k the sampled values, one step apart):
-//   x_law = x_k + (x_k - x_{k-1}) - (x_{k-1} - x_{k-2}) / 2
-// i.e. the next step's change extrapolated linearly from the last two (with one recorded step
-// only: x_k + (x_k - x_{k-1}) / 2; with none, or samples not one step apart: x_k), and the onset
-// rate is interpolated at theta + 1/2 instead of theta. It costs nothing per step (four more
-// numbers of state). RK4's states are synchronous, so it uses the velocities as they are.
-// Measured on a point-mass impact (steel, K = 6.61e10 N/m^1.5, 0.15 kg, LN, 0.5..4 m/s, 7 phases
-// of the onset within the step), range of the first-impact peak force error at 1/2/3/5 us:
-//   c_e = 0.9  this scheme   -0.03..+0.02 / -0.22..+0.08 / -0.43..+0.18 / -1.16..+0.32 %
-//              rate as is    +0.17..+0.31 / +0.33..+0.68 / +0.41..+1.12 / +0.35..+2.12 %
-//   c_e = 0.5  this scheme   -0.07..+0.01 / -0.27..+0.04 / -0.60..-0.01 / -2.85..-0.01 %
-//              rate as is    +0.59..+0.96 / +1.12..+2.01 / +1.61..+3.08 / +2.43..+5.77 %
-// with restitution errors of at most 0.01/0.04/0.11/0.33 % (rate as is: 0.00/0.02/0.06/0.26 %).
-// So a first impact stays within 1 % up to 3 us instead of 1 us. Two cheaper variants were
-// worse: the half-step advance with the last rate change only (same peaks, restitution errors
-// up to 1.65 % at 5 us) and evaluating the whole force at a predicted mid-step position
-// (-2..-12 %: the position is not the lagging quantity). The remaining error is mostly the
-// sampling of the peak between steps: RK4 at the same steps gives -0.06..0 / -0.28..0 /
-// -0.49..0 / -1.33..+0.04 % at four times the cost.
+// In-step treatment. The force is evaluated once at the step's state (the integrator's first
+// force evaluation) and held over the step. MuJoCo's Euler, implicit, implicitfast and discrete
+// integrators are semi-implicit (velocities first, then positions with the new velocities): the
+// positions q_k are at t_k, the velocity qvel_k is the one of the interval before t_k, and the
+// step's velocity change dv carries the interval after it. A rate read from (q_k, qvel_k) is
+// therefore half a step behind in its velocity part only; its kinematic part (the turning
+// normal, the Jacobian's own change, J'dot qdot, of order omega^2 l on a mechanism) is at t_k
+// already. So only the generalized-velocity part is advanced, along the rows J_n (normal rate)
+// and J_t (tangential velocity) over the dofs at q_k:
+//   dv = h M^-1 J' f  +  other     (this joint's own force f, and every other force)
+// The other forces' change is taken from the last step (the recorded dv minus this joint's own
+// response there, kept in the state as nv numbers): constant extrapolation, which stays stable
+// whatever share of the own response the solver's constraints or an implicit actuator take
+// (M^-1 overstates the joint's mobility then, never understates it). This joint's own response is
+// taken at this step: with w_nn = J_n M^-1 J_n', w_nt = J_n M^-1 J_t', w_tt = J_t M^-1 J_t'.
 //
-// Friction near rest. Ambrosio's ramp between v0 and v1 is stiff: an explicit step resolves it
-// only while h mu F_n / ((v1 - v0) m_t) < 2 (m_t the effective mass along t), i.e. below about
-// 1 kN at 1 us, mu = 0.1, m_t = 0.06 kg and the default v0, v1. In a harder impact that brings
-// the sliding to rest, v_t chatters around 0 by about h mu F_n / m_t per step instead of
-// settling in the ramp (the friction force stays bounded by mu F_n; the recorded dissipated
-// work then carries an error of the order of that chatter). Gross sliding is unaffected.
+// Normal force. Over the step the normal rate obeys r' = A - (g/h) r with r(0) = r0 = J_n qvel_k
+// (the sampled rate), h A = J_n other - h w_nn F_el + h w_nt F_t (the other forces, the elastic
+// force held, the last step's friction), and g = h w_nn C the law's damping C = dF_n/d(delta_dot)
+// (chi F_el / v_in for the dissipative laws, C_max STEP(delta) for the impact law, 0 for Hertz).
+// The rate entering the law is r's exact mean over the step,
+//   rate = r0 phi1(-g) + h A psi(g),  phi1(-g) = (1 - e^-g)/g,  psi(g) = (g - 1 + e^-g)/g^2,
+// i.e. the damping integrated exponentially: for small g it is r0 + (h/2)(A - (g/h) r0), the
+// rate at the step's time; for any g (a grazing contact's damping at the 1 mm/s floor of v_in
+// reaches g >> 1 at the default step) it stays bounded by r0 and the rate's change, so no
+// approach speed makes the damping unstable. (An explicit damping term, advanced by
+// extrapolation, is stable only for g below about 0.5; a grazing re-onset of the c = 0.1 mm
+// slider-crank reaches 0.58 at 3 us.) The elastic force is held over the step, so the time-step
+// rule stays a stiffness rule (omega h).
+// The rate at a sample's time, for the approach speed: at the current step
+// r0 + (1/2) J_n other (no own force yet at onset), at the last step r0 + (1/2) J_n dv from the
+// velocity change it actually had (the mean of its start and end rates).
 //
-// State (nstate = 11 mjtNums per instance, part of mjSTATE_PLUGIN, so it travels with
+// Friction near rest. Ambrosio's ramp between v0 and v1 is stiff: explicitly it is resolved only
+// while h mu F_n w_tt / (v1 - v0) < 2 (about 1 kN at 1 us, mu = 0.1, an effective tangential
+// mass of 0.06 kg), and beyond that v_t chatters around 0. The friction force is therefore taken
+// at the tangential velocity it leaves at the step's end,
+//   v_end = v_t0 + J_t other - h w_nt F_n + h w_tt F_t(v_end),  F_t(v) = -mu F_n c_d(v) sign(v)
+// (backward Euler in v_t: v + h w_tt mu F_n c_d(v) sign(v) increases with v, so the root is
+// unique, and each piece of the ramp is linear, so it is solved exactly). In gross sliding
+// through the step it is the sliding friction -mu F_n sign(v_t) as before; near rest v_t settles
+// inside the ramp instead of changing sign every step. RK4's states are synchronous and its
+// force explicit: it uses the sampled rates and velocities as they are.
+//
+// State (nstate = 9 + nv mjtNums per instance, part of mjSTATE_PLUGIN, so it travels with
 // mj_getState/mj_setState and through mujoco.rollout chunks):
 //   [0] time of the last recorded sample [s]    [1] delta there [m]
-//   [2] geometric delta_dot there [m/s]         [3] the same one step earlier [m/s]
-//   [4] geometric v_t there [m/s]               [5] the same one step earlier [m/s]
-//   [6] recorded samples one step apart: 0, 1 or 2 (2: [3] and [5] are valid)
-//   [7] 1 while in an impact, else 0            [8] approach speed of that impact [m/s]
-//   [9] dissipated work so far [J]              [10] number of recorded steps
+//   [2] normal rate at that sample's time [m/s] [3] friction force F_t applied there [N]
+//   [4] 1 once a sample is recorded, else 0     [5] 1 while in an impact, else 0
+//   [6] approach speed of that impact [m/s]     [7] dissipated work so far [J]
+//   [8] number of recorded steps                [9 .. 9 + nv) the last step's velocity change
+//                                                    from the other forces [m/s, rad/s]
 // The state is updated once per step, in `advance` (which MuJoCo calls once per mj_step, after
 // integration, whatever the integrator), from the force evaluation made at the step's start
-// state. Because `compute` runs several times per step under RK4 and kinematics in mjData
-// describe the last of those evaluations by the time `advance` runs, every passive evaluation
-// is kept in a small per-mjData cache keyed by d->time; `advance` commits the one whose time is
-// the step's start time (time + timestep == new d->time). `compute` never writes the state.
-// Setting qpos/qvel by hand in the middle of a run leaves a state that describes the old
-// trajectory: reset it (mj_resetData, or zero the instance's plugin_state) when doing so.
+// state and the velocities the step ended with. Because `compute` runs several times per step
+// under RK4 and kinematics in mjData describe the last of those evaluations by the time
+// `advance` runs, every passive evaluation is kept in a small per-mjData cache keyed by d->time
+// (with the velocities, the own response and J_n it was made with); `advance` commits the one
+// whose time is the step's start time (time + timestep == new d->time). `compute` never writes
+// the state. The sensor stage reads the cached evaluation of the same state instead of
+// evaluating it again. Setting qpos/qvel by hand in the middle of a run leaves a state that
+// describes the old trajectory: reset it (mj_resetData, or zero the instance's plugin_state)
+// when doing so.
 //
 // Sensor output (nsensordata = 8), evaluated at the current state:
 //   [0] F_n normal force [N] (>= 0)   [1] F_t tangential force on the journal along t [N]
@@ -98,7 +111,8 @@
 //   [4] v_in approach speed [m/s] (0 out of contact)
 //   [5] contact potential energy K delta^(n+1) / (n+1) [J] (0 for delta <= 0)
 //   [6] work dissipated by the contact so far [J] (normal damping + friction; recorded once per
-//       step in `advance` as timestep * power of the applied force, >= 0)
+//       step in `advance` as timestep * power of the applied force: (F_n - F_el) rate - F_t v_t,
+//       v_t the mean of the step's start and end tangential velocities)
 //   [7] |e| eccentricity magnitude [m]
 //
 // Config attributes (strings; validated in Python before compiling, re-checked here):
@@ -122,14 +136,18 @@
 #include <mujoco/mujoco.h>
 
 #define JB_NAME "clearance.journal_bearing"
-#define JB_NSTATE 11
 #define JB_NSENSOR 8
 #define JB_NCACHE 3  // RK4 evaluates the force at t, t + h/2 (twice) and t + h
 
-// state layout
+// state layout of a journal bearing (B_OTHER: nv values)
+enum {
+  B_TIME = 0, B_DELTA, B_RATE, B_FT, B_HAVE, B_CONTACT, B_VIN, B_WORK, B_NSTEP, B_OTHER
+};
+
+// state layout of a backlash stop
 enum {
   S_TIME = 0, S_DELTA, S_RATE, S_RATE2, S_VT, S_VT2, S_HAVE, S_CONTACT, S_VIN, S_WORK,
-  S_NSTEP
+  S_NSTEP, S_COUNT
 };
 
 // contact laws, in the order of clearance.model.ContactLaw
@@ -180,6 +198,15 @@ typedef struct {
   int* sensor_adr;           // sensordata addresses of this instance's sensors
   jbEval cache[JB_NCACHE];   // passive evaluations since the last advance
   int cache_next;            // round-robin slot
+  // in-step treatment (semi-implicit integrators), one block of 17 + 3 JB_NCACHE times nv values
+  // allocated in init (vec_t follows vec_n, ut follows un: each pair is solved in one call):
+  mjtNum* vec_n;             // row of the normal rate over the dofs (nv)
+  mjtNum* vec_t;             // row of the tangential velocity (nv)
+  mjtNum* un;                // M^-1 vec_n' (nv)
+  mjtNum* ut;                // M^-1 vec_t' (nv)
+  mjtNum* own;               // this joint's velocity change over the step, h M^-1 J' f (nv)
+  mjtNum* scratch;           // two bodies' Jacobians (12 nv)
+  mjtNum* slot_vec;          // per cache slot: qvel, own and vec_n at the evaluation (3 nv each)
 } jbData;
 
 
@@ -369,19 +396,29 @@ static int one_step_after(mjtNum t, mjtNum t0, mjtNum h) {
   return mju_abs(t - (t0 + h)) <= 1e-9 * h;
 }
 
-// 1 if the recorded sample is one step older than the current time
-static int sample_is_last_step(const mjModel* m, const mjData* d, const mjtNum* s) {
-  return s[S_HAVE] != 0 && one_step_after(d->time, s[S_TIME], m->opt.timestep);
+// 1 if a sample recorded at `sample_time` (`have` != 0: recorded at all) is one step old
+static int is_last_step(const mjModel* m, const mjData* d, mjtNum have, mjtNum sample_time) {
+  return have != 0 && one_step_after(d->time, sample_time, m->opt.timestep);
 }
 
-// 1 if the recorded sample is recent enough to locate an onset (RK4 stages reach 2 steps)
+// 1 if such a sample is recent enough to locate an onset (RK4 stages reach 2 steps)
+static int is_recent(const mjModel* m, const mjData* d, mjtNum have, mjtNum sample_time) {
+  mjtNum age = d->time - sample_time;
+  return have != 0 && age > 0 && age <= 2 * m->opt.timestep * (1 + 1e-9);
+}
+
+// the backlash stop's sample tests (its state layout: S_HAVE, S_TIME)
+static int sample_is_last_step(const mjModel* m, const mjData* d, const mjtNum* s) {
+  return is_last_step(m, d, s[S_HAVE], s[S_TIME]);
+}
+
 static int sample_is_recent(const mjModel* m, const mjData* d, const mjtNum* s) {
-  mjtNum age = d->time - s[S_TIME];
-  return s[S_HAVE] != 0 && age > 0 && age <= 2 * m->opt.timestep * (1 + 1e-9);
+  return is_recent(m, d, s[S_HAVE], s[S_TIME]);
 }
 
 // a sampled velocity x advanced by half a step, from the samples x1, x2 one and two steps back
-// (semi-implicit integrators only; see "In-step treatment")
+// (the backlash stop's treatment, semi-implicit integrators only: its rate has a constant
+// Jacobian, so the whole change of x is the change of the generalized velocities)
 static mjtNum half_step_ahead(const mjModel* m, const mjData* d, const mjtNum* s,
                               mjtNum x, mjtNum x1, mjtNum x2) {
   if (!semi_implicit(m) || !sample_is_last_step(m, d, s)) {
@@ -413,23 +450,93 @@ static mjtNum normal_force(const jbData* c, mjtNum delta, mjtNum rate, mjtNum vi
   return f > 0 ? f : 0.0;
 }
 
-// Ambrosio friction, the operations of laws._friction
+// the law's damping coefficient dF_n/d(delta_dot) [N s/m] at delta > 0 (0: Hertz)
+static mjtNum damping_coefficient(const jbData* c, mjtNum delta, mjtNum fel, mjtNum vin) {
+  if (c->law == LAW_HERTZ) {
+    return 0.0;
+  } else if (c->law == LAW_IMPACT) {
+    mjtNum z = mju_clip(delta / c->d_max, 0.0, 1.0);
+    return c->c_max * (z * z * (3.0 - 2.0 * z));
+  }
+  return fel * c->chi / vin;
+}
+
+// Ambrosio's coefficient c_d(v) sign(v): F_t = -mu F_n ramp(v), the operations of laws._friction
+static mjtNum friction_ramp(const jbData* c, mjtNum vt) {
+  mjtNum cd = mju_clip((mju_abs(vt) - c->v0) / (c->v1 - c->v0), 0.0, 1.0);
+  mjtNum sign = vt > 0 ? 1.0 : (vt < 0 ? -1.0 : 0.0);
+  return cd * sign;
+}
+
+// Ambrosio friction at v_t, the operations of laws._friction
 static mjtNum friction_force(const jbData* c, mjtNum fn, mjtNum vt) {
   if (c->friction == 0) {
     return 0.0;
   }
-  mjtNum cd = mju_clip((mju_abs(vt) - c->v0) / (c->v1 - c->v0), 0.0, 1.0);
-  mjtNum sign = vt > 0 ? 1.0 : (vt < 0 ? -1.0 : 0.0);
-  return -c->friction * cd * fn * sign + 0.0;
+  return -c->friction * friction_ramp(c, vt) * fn + 0.0;
 }
 
-// evaluate the contact at the current kinematics of d; pure in (d, state)
-static void evaluate(const mjModel* m, const mjData* d, const jbData* c, const mjtNum* s,
-                     jbEval* ev) {
+// the tangential velocity v at the step's end that friction evaluated there gives:
+// v = v_free + k ramp(v)... with k = -h w_tt mu F_n <= 0, i.e. v + kk ramp(v) = v_free with
+// kk = h w_tt mu F_n >= 0; v + kk ramp(v) increases with v, so the root is unique and each
+// piece of the ramp is linear (see "Friction near rest")
+static mjtNum implicit_sliding_velocity(const jbData* c, mjtNum v_free, mjtNum kk) {
+  mjtNum a = mju_abs(v_free), sign = v_free >= 0 ? 1.0 : -1.0;
+  if (a <= c->v0 || kk <= 0) {
+    return v_free;
+  }
+  if (a - kk >= c->v1) {
+    return sign * (a - kk);  // gross sliding through the step
+  }
+  mjtNum slope = kk / (c->v1 - c->v0);
+  return sign * (a + slope * c->v0) / (1.0 + slope);  // inside the ramp
+}
+
+// phi1(-g) = (1 - exp(-g)) / g and psi(g) = (g - 1 + exp(-g)) / g^2 for g >= 0: the mean of
+// r(t) over a step h for r' = A - (g / h) r, r(0) = r0, is r0 phi1(-g) + h A psi(g)
+static void exponential_means(mjtNum g, mjtNum* phi1, mjtNum* psi) {
+  if (g < 1e-3) {  // series: the next terms are g^4 / 120 and g^4 / 720 (< 1e-14 here)
+    *phi1 = 1.0 - g / 2.0 + g * g / 6.0 - g * g * g / 24.0;
+    *psi = 0.5 - g / 6.0 + g * g / 24.0 - g * g * g / 120.0;
+  } else {
+    mjtNum em1 = expm1(-g);
+    *phi1 = -em1 / g;
+    *psi = (g + em1) / (g * g);
+  }
+}
+
+// the rows of the normal rate and of the tangential velocity over the dofs: with the
+// translational and rotational Jacobians of the journal and bearing bodies at their sites,
+//   J_n = n' (Jp_J(p_J) - Jp_B(p_B))
+//   J_t = t' (Jp_J(p_J) - Jp_B(p_B)) + R_J z' Jr_J - (R_J + c) z' Jr_B
+// (the contact points sit at R_J n and (R_J + c) n from the centres, and t' (w x r n) = r z' w);
+// scratch: 12 nv
+static void contact_rows(const mjModel* m, const mjData* d, const jbData* c, const mjtNum n[3],
+                         const mjtNum t[3], const mjtNum z[3], mjtNum* jn, mjtNum* jt,
+                         mjtNum* scratch) {
+  int nv = m->nv;
+  mjtNum *pj = scratch, *rj = scratch + 3 * nv, *pb = scratch + 6 * nv, *rb = scratch + 9 * nv;
+  mj_jac(m, d, pj, rj, d->site_xpos + 3 * c->journal_site, c->journal_body);
+  mj_jac(m, d, pb, rb, d->site_xpos + 3 * c->bearing_site, c->bearing_body);
+  mjtNum arm_j = c->journal_radius, arm_b = c->journal_radius + c->clearance;
+  for (int i = 0; i < nv; i++) {
+    mjtNum dx = pj[i] - pb[i], dy = pj[nv + i] - pb[nv + i], dzz = pj[2 * nv + i] - pb[2 * nv + i];
+    jn[i] = n[0] * dx + n[1] * dy + n[2] * dzz;
+    jt[i] = t[0] * dx + t[1] * dy + t[2] * dzz +
+            arm_j * (z[0] * rj[i] + z[1] * rj[nv + i] + z[2] * rj[2 * nv + i]) -
+            arm_b * (z[0] * rb[i] + z[1] * rb[nv + i] + z[2] * rb[2 * nv + i]);
+  }
+}
+
+// evaluate the contact at the current kinematics of d; pure in (d, state). For the
+// semi-implicit integrators it also fills the slot's vectors (jbData.vec, see store).
+static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jbEval* ev) {
   const mjtNum* pj = d->site_xpos + 3 * c->journal_site;
   const mjtNum* pb = d->site_xpos + 3 * c->bearing_site;
   const mjtNum* mat = d->site_xmat + 9 * c->bearing_site;
   mjtNum z[3] = {mat[2], mat[5], mat[8]};
+  mjtNum h = m->opt.timestep;
+  int nv = m->nv;
 
   // eccentricity in the bearing plane
   mjtNum dist[3], e[3];
@@ -475,31 +582,80 @@ static void evaluate(const mjModel* m, const mjData* d, const jbData* c, const m
   mju_add3(vpb, vb + 3, wb);
   mju_sub3(vp, vpj, vpb);
   mjtNum vt_geo = mju_dot3(ev->tangent, vp);
-
-  // velocities entering the laws: half a step ahead for semi-implicit integrators
   mjtNum delta = ecc - c->clearance;
-  int last_step = sample_is_last_step(m, d, s);
-  mjtNum rate = half_step_ahead(m, d, s, rate_geo, s[S_RATE], s[S_RATE2]);
-  mjtNum vt = half_step_ahead(m, d, s, vt_geo, s[S_VT], s[S_VT2]);
+
+  // In-step treatment (semi-implicit integrators): the rows of the normal rate and of the
+  // tangential velocity over the dofs, the joint's own inverse inertias along them, and the
+  // last step's velocity change from every other force (state), projected on the rows.
+  int instep = semi_implicit(m);
+  int last = is_last_step(m, d, s[B_HAVE], s[B_TIME]);
+  mjtNum w_nn = 0, w_nt = 0, w_tt = 0, other_n = 0, other_t = 0;
+  mjtNum* jn = c->vec_n;
+  mjtNum* jt = c->vec_t;
+  if (instep) {
+    contact_rows(m, d, c, n, ev->tangent, z, jn, jt, c->scratch);
+    mj_solveM(m, d, c->un, jn, 2);  // un, ut: the two rows stored one after the other
+    w_nn = mju_dot(jn, c->un, nv);
+    w_nt = mju_dot(jn, c->ut, nv);
+    w_tt = mju_dot(jt, c->ut, nv);
+    if (last) {
+      other_n = mju_dot(jn, s + B_OTHER, nv);
+      other_t = mju_dot(jt, s + B_OTHER, nv);
+    }
+  }
+
+  // the rate at the step's time with no force of this joint: the sampled rate (half a step
+  // behind for the semi-implicit integrators) plus half the other forces' velocity change
+  mjtNum rate_free = rate_geo + 0.5 * other_n;
 
   // approach speed: kept during an impact, located at the crossing at onset
   mjtNum vin = 0;
   if (delta > 0) {
-    if (s[S_CONTACT] != 0) {
-      vin = s[S_VIN];
-    } else if (sample_is_recent(m, d, s) && s[S_DELTA] <= 0) {
-      mjtNum theta = s[S_DELTA] / (s[S_DELTA] - delta);
-      mjtNum w = (semi_implicit(m) && last_step) ? theta + 0.5 : theta;
-      vin = s[S_RATE] + w * (rate_geo - s[S_RATE]);
+    if (s[B_CONTACT] != 0) {
+      vin = s[B_VIN];
+    } else if (s[B_DELTA] <= 0 && (instep ? last : is_recent(m, d, s[B_HAVE], s[B_TIME]))) {
+      mjtNum theta = s[B_DELTA] / (s[B_DELTA] - delta);
+      vin = s[B_RATE] + theta * (rate_free - s[B_RATE]);
     } else {
-      vin = rate;
+      vin = rate_free;
     }
     vin = vin > c->min_speed ? vin : c->min_speed;
   }
 
-  mjtNum fel;
+  // the rate entering the law: the mean over the step of the normal rate's velocity part,
+  // with this joint's damping integrated exponentially and its elastic force held
+  mjtNum rate = rate_geo, fel = 0;
+  if (delta > 0) {
+    fel = c->stiffness * pow(delta, c->exponent);
+  }
+  if (instep) {
+    mjtNum ft_last = last ? s[B_FT] : 0.0;
+    mjtNum g = delta > 0 ? h * w_nn * damping_coefficient(c, delta, fel, vin) : 0.0;
+    mjtNum phi1, psi;
+    exponential_means(g, &phi1, &psi);
+    rate = rate_geo * phi1 + (other_n - h * w_nn * fel + h * w_nt * ft_last) * psi;
+  }
   mjtNum fn = normal_force(c, delta, rate, vin, &fel);
-  mjtNum ft = friction_force(c, fn, vt);
+
+  // friction at the tangential velocity it leaves at the step's end (semi-implicit), or at
+  // the sampled one (RK4)
+  mjtNum vt = vt_geo, ft = 0;
+  if (c->friction != 0 && fn > 0) {
+    if (instep) {
+      mjtNum v_free = vt_geo + other_t - h * w_nt * fn;
+      mjtNum v_end = implicit_sliding_velocity(c, v_free, h * w_tt * c->friction * fn);
+      ft = friction_force(c, fn, v_end);
+      vt = 0.5 * (vt_geo + v_end);
+    } else {
+      ft = friction_force(c, fn, vt_geo);
+    }
+  }
+
+  if (instep) {  // this joint's own velocity change over the step, h M^-1 J' f
+    for (int i = 0; i < nv; i++) {
+      c->own[i] = h * (ft * c->ut[i] - fn * c->un[i]);
+    }
+  }
 
   ev->time = d->time;
   ev->valid = 1;
@@ -565,8 +721,23 @@ static const void* cache_step_start(const void* cache, size_t stride, int n, mjt
   return NULL;
 }
 
-static void store(jbData* c, const jbEval* ev) {
-  c->cache[cache_slot(c->cache, sizeof(jbEval), JB_NCACHE, ev->time, &c->cache_next)] = *ev;
+// keep an evaluation made at d's state (with the vectors the in-step treatment left in c)
+static void store(const mjModel* m, const mjData* d, jbData* c, const jbEval* ev) {
+  int slot = cache_slot(c->cache, sizeof(jbEval), JB_NCACHE, ev->time, &c->cache_next);
+  c->cache[slot] = *ev;
+  if (semi_implicit(m)) {
+    int nv = m->nv;
+    mjtNum* v = c->slot_vec + 3 * nv * slot;
+    mju_copy(v, d->qvel, nv);
+    mju_copy(v + nv, c->own, nv);
+    mju_copy(v + 2 * nv, c->vec_n, nv);
+  }
+}
+
+// the cache slot holding the evaluation made one step before `time`, or -1
+static int step_start_slot(const jbData* c, mjtNum time, mjtNum h) {
+  const jbEval* ev = (const jbEval*)cache_step_start(c->cache, sizeof(jbEval), JB_NCACHE, time, h);
+  return ev ? (int)(ev - c->cache) : -1;
 }
 
 static void clear_cache(jbData* c) {
@@ -579,8 +750,32 @@ static void clear_cache(jbData* c) {
 
 //---------------------------------- plugin callbacks ----------------------------------------------
 
+// the cache slot evaluated at d's time, velocities and eccentricity (semi-implicit integrators,
+// where an evaluation costs Jacobians and solves), or -1: a sensor reads it instead of
+// evaluating the same state again
+static int same_state_slot(const mjModel* m, const mjData* d, const jbData* c) {
+  if (!semi_implicit(m)) {
+    return -1;
+  }
+  int nv = m->nv;
+  mjtNum dist[3], e[3];
+  const mjtNum* mat = d->site_xmat + 9 * c->bearing_site;
+  mjtNum z[3] = {mat[2], mat[5], mat[8]};
+  mju_sub3(dist, d->site_xpos + 3 * c->journal_site, d->site_xpos + 3 * c->bearing_site);
+  mju_addScl3(e, dist, z, -mju_dot3(dist, z));
+  mjtNum ecc = mju_norm3(e);
+  for (int i = 0; i < JB_NCACHE; i++) {
+    const jbEval* ev = c->cache + i;
+    if (ev->valid && ev->time == d->time && ev->ecc == ecc &&
+        !memcmp(c->slot_vec + 3 * nv * i, d->qvel, sizeof(mjtNum) * nv)) {
+      return i;
+    }
+  }
+  return -1;
+}
+
 static int jb_nstate(const mjModel* m, int instance) {
-  return JB_NSTATE;
+  return B_OTHER + m->nv;
 }
 
 // the sensordata addresses of a plugin instance's sensors: a malloc'd array (at least one
@@ -609,6 +804,12 @@ static int jb_nsensordata(const mjModel* m, int instance, int sensor_id) {
   return JB_NSENSOR;
 }
 
+static void jb_free(jbData* c) {
+  free(c->sensor_adr);
+  free(c->vec_n);
+  free(c);
+}
+
 static int jb_init(const mjModel* m, mjData* d, int instance) {
   jbData* c = (jbData*)calloc(1, sizeof(jbData));
   if (!c) {
@@ -620,11 +821,19 @@ static int jb_init(const mjModel* m, mjData* d, int instance) {
     return -1;
   }
   c->sensor_adr = instance_sensors(m, instance, &c->nsensor);
-  if (!c->sensor_adr) {
-    free(c);
+  int nv = m->nv > 0 ? m->nv : 1;
+  c->vec_n = (mjtNum*)calloc((size_t)(17 + 3 * JB_NCACHE) * nv, sizeof(mjtNum));
+  if (!c->sensor_adr || !c->vec_n) {
+    jb_free(c);
     mju_warning(JB_NAME " instance %d: out of memory", instance);
     return -1;
   }
+  c->vec_t = c->vec_n + nv;
+  c->un = c->vec_n + 2 * nv;
+  c->ut = c->vec_n + 3 * nv;
+  c->own = c->vec_n + 4 * nv;
+  c->scratch = c->vec_n + 5 * nv;
+  c->slot_vec = c->vec_n + 17 * nv;
   d->plugin_data[instance] = (uintptr_t)c;
   return 0;
 }
@@ -632,8 +841,7 @@ static int jb_init(const mjModel* m, mjData* d, int instance) {
 static void jb_destroy(mjData* d, int instance) {
   jbData* c = (jbData*)d->plugin_data[instance];
   if (c) {
-    free(c->sensor_adr);
-    free(c);
+    jb_free(c);
   }
   d->plugin_data[instance] = 0;
 }
@@ -644,11 +852,12 @@ static void jb_copy(mjData* dest, const mjModel* m, const mjData* src, int insta
   if (to && from) {
     memcpy(to->cache, from->cache, sizeof(to->cache));
     to->cache_next = from->cache_next;
+    mju_copy(to->slot_vec, from->slot_vec, 3 * JB_NCACHE * m->nv);
   }
 }
 
 static void jb_reset(const mjModel* m, mjtNum* plugin_state, void* plugin_data, int instance) {
-  mju_zero(plugin_state, JB_NSTATE);
+  mju_zero(plugin_state, B_OTHER + m->nv);
   if (plugin_data) {
     clear_cache((jbData*)plugin_data);
   }
@@ -658,10 +867,15 @@ static void jb_compute(const mjModel* m, mjData* d, int instance, int capability
   jbData* c = (jbData*)d->plugin_data[instance];
   const mjtNum* s = d->plugin_state + m->plugin_stateadr[instance];
   jbEval ev;
-  evaluate(m, d, c, s, &ev);
+  int slot = (capability_bit & mjPLUGIN_PASSIVE) ? -1 : same_state_slot(m, d, c);
+  if (slot >= 0) {
+    ev = c->cache[slot];  // the sensor stage after the passive stage of one forward pass
+  } else {
+    evaluate(m, d, c, s, &ev);
+  }
 
   if (capability_bit & mjPLUGIN_PASSIVE) {
-    store(c, &ev);
+    store(m, d, c, &ev);
     apply(m, d, c, &ev);
   }
 
@@ -669,7 +883,7 @@ static void jb_compute(const mjModel* m, mjData* d, int instance, int capability
     mjtNum out[JB_NSENSOR] = {
       ev.fn, ev.ft, ev.delta, ev.rate, ev.vin,
       ev.delta > 0 ? ev.fel * ev.delta / (c->exponent + 1) : 0.0,
-      s[S_WORK], ev.ecc
+      s[B_WORK], ev.ecc
     };
     for (int i = 0; i < c->nsensor; i++) {
       mju_copy(d->sensordata + c->sensor_adr[i], out, JB_NSENSOR);
@@ -682,20 +896,31 @@ static void jb_advance(const mjModel* m, mjData* d, int instance) {
   jbData* c = (jbData*)d->plugin_data[instance];
   mjtNum* s = d->plugin_state + m->plugin_stateadr[instance];
   mjtNum h = m->opt.timestep;
-  const jbEval* ev = (const jbEval*)cache_step_start(c->cache, sizeof(jbEval), JB_NCACHE, d->time, h);
-  if (ev) {  // none when passive forces are disabled: no force was applied, nothing to record
-    int consecutive = s[S_HAVE] != 0 && one_step_after(ev->time, s[S_TIME], h);
-    s[S_WORK] += h * ev->power;
-    s[S_CONTACT] = ev->delta > 0 ? 1.0 : 0.0;
-    s[S_VIN] = ev->delta > 0 ? ev->vin : 0.0;
-    s[S_RATE2] = consecutive ? s[S_RATE] : 0.0;
-    s[S_VT2] = consecutive ? s[S_VT] : 0.0;
-    s[S_HAVE] = consecutive ? 2.0 : 1.0;
-    s[S_TIME] = ev->time;
-    s[S_DELTA] = ev->delta;
-    s[S_RATE] = ev->rate_geo;
-    s[S_VT] = ev->vt_geo;
-    s[S_NSTEP] += 1.0;
+  int slot = step_start_slot(c, d->time, h);
+  if (slot >= 0) {  // none when passive forces are disabled: no force was applied, nothing to record
+    const jbEval* ev = c->cache + slot;
+    s[B_WORK] += h * ev->power;
+    s[B_CONTACT] = ev->delta > 0 ? 1.0 : 0.0;
+    s[B_VIN] = ev->delta > 0 ? ev->vin : 0.0;
+    s[B_TIME] = ev->time;
+    s[B_DELTA] = ev->delta;
+    s[B_FT] = ev->ft;
+    s[B_RATE] = ev->rate_geo;
+    if (semi_implicit(m)) {
+      // the step's velocity change: what this joint's force did, the rest (other forces),
+      // and the rate at the evaluation's time (the mean of the step's start and end rates)
+      int nv = m->nv;
+      const mjtNum* v = c->slot_vec + 3 * nv * slot;
+      mjtNum half = 0;
+      for (int i = 0; i < nv; i++) {
+        mjtNum dv = d->qvel[i] - v[i];
+        s[B_OTHER + i] = dv - v[nv + i];
+        half += v[2 * nv + i] * dv;
+      }
+      s[B_RATE] += 0.5 * half;
+    }
+    s[B_HAVE] = 1.0;
+    s[B_NSTEP] += 1.0;
   }
   clear_cache(c);
 }
@@ -1011,13 +1236,18 @@ static void wm_advance(const mjModel* m, mjData* d, int instance) {
 // and it is applied as passive generalized forces: -s T on the load dof and +s T on the motor
 // dof (the teeth push the two sides apart, back into the band). No tendon limit and no
 // constraint row is involved: the stop is the law itself, at whatever inertia the pose gives.
-// The approach speed v_in of an impact, the in-step treatment of the rates (half a step ahead
-// for the semi-implicit integrators), the onset located inside the step, the evaluation cache
-// and `advance` are those of clearance.journal_bearing (see its header above), with delta and
-// delta_dot as defined here; a sample taken on the other side of the band is no history (the
-// rate changes sign at r = 0).
+// The approach speed v_in is recorded at onset and kept for the impact, the onset located inside
+// the step, as for clearance.journal_bearing (see its header above); the evaluation cache and
+// `advance` work as there. The in-step treatment is simpler: delta_dot = s (v_load - v_motor) has
+// a constant Jacobian (no kinematic part), so for the semi-implicit integrators the whole sampled
+// rate lags half a step, and it is advanced by half a step with its change extrapolated from the
+// last two steps,
+//   x_law = x_k + (x_k - x_{k-1}) - (x_{k-1} - x_{k-2}) / 2
+// (with one recorded step only x_k + (x_k - x_{k-1}) / 2; with none, x_k), and the onset rate
+// is interpolated at theta + 1/2. A sample taken on the other side of the band is no history
+// (the rate changes sign at r = 0).
 //
-// State (nstate = 11 mjtNums per instance; slots 0..3 and 6..10 as the journal bearing's):
+// State (nstate = 11 mjtNums per instance):
 //   [0] time of the last recorded sample [s]    [1] delta there [rad]
 //   [2] geometric delta_dot there [rad/s]       [3] the same one step earlier [rad/s]
 //   [4] side s of the band there (+1, -1, 0)    [5] peak T of the current or last impact [N m]
@@ -1156,6 +1386,10 @@ static void bs_evaluate(const mjModel* m, const mjData* d, const bsData* c, cons
   ev->power = delta > 0 ? (torque - tel) * rate : 0.0;
 }
 
+static int bs_nstate(const mjModel* m, int instance) {
+  return S_COUNT;
+}
+
 static int bs_nsensordata(const mjModel* m, int instance, int sensor_id) {
   return BS_NSENSOR;
 }
@@ -1206,7 +1440,7 @@ static void bs_clear_cache(bsData* c) {
 }
 
 static void bs_reset(const mjModel* m, mjtNum* plugin_state, void* plugin_data, int instance) {
-  mju_zero(plugin_state, JB_NSTATE);
+  mju_zero(plugin_state, S_COUNT);
   if (plugin_data) {
     bs_clear_cache((bsData*)plugin_data);
   }
@@ -1311,7 +1545,7 @@ mjPLUGIN_LIB_INIT(clearance_journal_bearing) {
   stop.needstage = mjSTAGE_VEL;
   stop.nattribute = sizeof(kStopAttributes) / sizeof(kStopAttributes[0]);
   stop.attributes = kStopAttributes;
-  stop.nstate = jb_nstate;
+  stop.nstate = bs_nstate;
   stop.nsensordata = bs_nsensordata;
   stop.init = bs_init;
   stop.destroy = bs_destroy;

@@ -131,7 +131,9 @@ def _no_warnings(data: mujoco.MjData) -> None:
 @pytest.mark.filterwarnings("ignore::clearance.contact_calibration.laws.UnverifiedLawWarning")
 @pytest.mark.parametrize("law", list(ContactLaw))
 def test_compiled_laws_equal_laws_py(law: ContactLaw) -> None:
-    model = _spec(law, friction=0.3).compile()
+    # RK4's states are synchronous: it takes the rates as they are (no in-step treatment, which
+    # test_in_step_treatment_equals_its_formula checks), so the law sees the geometric rate
+    model = _spec(law, friction=0.3, integrator=mujoco.mjtIntegrator.mjINT_RK4).compile()
     data = mujoco.MjData(model)
     adr = attributes.state_address(model, "joint")
     y = attributes.sensor_address(model, "joint")
@@ -173,7 +175,9 @@ def test_compiled_laws_equal_laws_py(law: ContactLaw) -> None:
 def test_geometry_and_applied_forces(moving_bearing: bool) -> None:
     # A rotated frame: the joint's plane is the bearing site's x-y plane, not the world's.
     quat = np.array([np.cos(0.3), np.sin(0.3) * 0.6, 0.0, np.sin(0.3) * 0.8])
-    model = _spec(LN, friction=0.2, moving_bearing=moving_bearing, frame_quat=tuple(quat)).compile()
+    # RK4: the rates as they are (see test_compiled_laws_equal_laws_py)
+    rk4 = mujoco.mjtIntegrator.mjINT_RK4
+    model = _spec(LN, friction=0.2, moving_bearing=moving_bearing, frame_quat=tuple(quat), integrator=rk4).compile()
     data = mujoco.MjData(model)
     y = attributes.sensor_address(model, "joint")
     rng = np.random.default_rng(3)
@@ -328,7 +332,7 @@ def test_state_is_updated_once_per_step(integrator: mujoco.mjtIntegrator) -> Non
     model, start = _bouncing(integrator, friction=0.0)
     nstep = 3000
     state, sensors = rollout.rollout(model, mujoco.MjData(model), start, nstep=nstep)
-    plugin = state[0, -1, -len(attributes.STATE_FIELDS) :]
+    plugin = state[0, -1, -attributes.state_size(model) :]
     assert plugin[S["steps"]] == nstep  # RK4 calls compute 4 times a step, advance once
     # The dissipated work is the sum of h * (F_n - K δⁿ) δ̇ over the force evaluations made at
     # each step's start state, which are exactly what the sensor recorded. Stage evaluations
@@ -369,7 +373,7 @@ def _impact_energy(timestep: float, law: ContactLaw) -> tuple[float, float]:
     power = (y[:, Y["normal_force"]] - K * d**1.5) * y[:, Y["penetration_rate"]]
     energy = 0.5 * (v**2) @ m + y[:, Y["potential_energy"]] + y[:, Y["dissipated_work"]] + 0.5 * timestep * power
     assert y[-1, Y["penetration"]] < 0  # separated
-    end = 0.5 * m @ qvel[-1] ** 2 + state[0, -1, -len(attributes.STATE_FIELDS) + S["dissipated_work"]]
+    end = 0.5 * m @ qvel[-1] ** 2 + state[0, -1, -attributes.state_size(model) + S["dissipated_work"]]
     return float(np.abs(energy / e0 - 1).max()), float(abs(end / e0 - 1))
 
 
