@@ -27,7 +27,9 @@ __all__ = [
     "ring_stiffness_coefficient",
     "ring_damping_coefficient",
     "force_ripple",
+    "band_ripple",
     "choose_segments",
+    "RIPPLE_BAND",
     "SEGMENT_RADIUS_FRACTION",
     "SEGMENT_CANDIDATES",
 ]
@@ -201,6 +203,16 @@ def force_ripple(geom: RingGeometry, delta: float, *, n_dir: int = 256) -> float
     return float((f.max() - f.min()) / mean)
 
 
+RIPPLE_BAND = (0.5, 0.71, 1.0, 1.41, 2.0)
+"""Depths, as multiples of the typical penetration, over which a ring's force ripple is judged
+(the ripple is not monotonic in N or depth: one depth can hide a bad count)."""
+
+
+def band_ripple(geom: RingGeometry, typical_penetration: float) -> float:
+    """Largest force ripple of ``geom`` over `RIPPLE_BAND` x ``typical_penetration`` [m] (`force_ripple`)."""
+    return max(force_ripple(geom, typical_penetration * k, n_dir=96) for k in RIPPLE_BAND)
+
+
 def choose_segments(
     bearing_radius: float,
     radial_clearance: float,
@@ -215,7 +227,7 @@ def choose_segments(
 
     The ripple of a ring of linear rows is not monotonic in N (engagement patterns
     repeat), so the rule asks for the limit to hold over a band of depths, from half to
-    twice ``typical_penetration`` [m], not at one depth.
+    twice ``typical_penetration`` [m], not at one depth (`band_ripple`).
 
     When no candidate meets the limit (light loads: the journal barely touches, as in a
     slow mechanism), the candidate up to ``fallback_max`` with the smallest ripple is
@@ -226,11 +238,9 @@ def choose_segments(
     """
     if typical_penetration <= 0:
         raise ValueError(f"typical_penetration must be > 0 (got {typical_penetration!r} m)")
-    band = typical_penetration * np.array([0.5, 0.71, 1.0, 1.41, 2.0])
     best = (math.inf, candidates[0])
     for n in candidates:
-        geom = RingGeometry.make(bearing_radius, radial_clearance, n, flat=flat)
-        ripple = max(force_ripple(geom, float(d), n_dir=96) for d in band)
+        ripple = band_ripple(RingGeometry.make(bearing_radius, radial_clearance, n, flat=flat), typical_penetration)
         if ripple < ripple_limit:
             return n
         if n <= fallback_max and ripple < best[0]:

@@ -167,7 +167,7 @@ def add_journal_and_bearing_visual(
 def add_journal_and_bearing(
     spec: mujoco.MjSpec,
     jbody: mujoco.MjsBody,
-    bbody: mujoco.MjsBody,
+    bbody: mujoco.MjsBody | mujoco.MjsFrame,
     name: str,
     journal: Placement,
     bearing: Placement,
@@ -185,7 +185,8 @@ def add_journal_and_bearing(
 
     Args:
         spec: the spec (the pairs are added to it).
-        jbody, bbody: the bodies holding the journal and the bearing ring.
+        jbody, bbody: the bodies holding the journal and the bearing ring (or a `<frame>` in the
+            bearing's body, where ``bearing`` is then placed).
         name: prefix of the names (``<name>__journal``, ``<name>__segNNN``, ``<name>__pairNNN``).
         journal, bearing: where each centre and ring plane sit in its body.
         ring: the bearing's geometry.

@@ -20,7 +20,7 @@ import pytest
 from clearance.builders import slider_crank
 from clearance.options import ModelOptions
 from clearance.retrofit import ControlTable, RadialPlay, RetrofitError, RetrofitOptions, retrofit, write_retrofit
-from clearance.retrofit.loop import CONNECT_IMPEDANCE, PIN_MASS
+from clearance.retrofit.masses import PIN_MASS_SHARE
 from clearance.run.preparation import prepare
 from clearance.run.retrofitted import load_retrofitted, simulate_retrofitted
 from clearance.run.simulation import simulate_prepared
@@ -65,11 +65,22 @@ def test_the_connect_gets_a_pin_and_keeps_every_body(loop):
     pin = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "clr_rod_slider__pin")
     slider = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "slider")
     assert m.nbody == t.nbody + 1 and m.body_parentid[pin] == slider
-    assert m.body_mass[pin] == PIN_MASS  # the one mass added; the others are checked equal by the retrofit
-    assert m.body_mass.sum() - PIN_MASS == pytest.approx(t.body_mass.sum(), rel=1e-15)  # float sum order
     eq = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_EQUALITY, "rod_slider")
-    assert m.eq_obj2id[eq] == pin and tuple(m.eq_solimp[eq, :2]) == (CONNECT_IMPEDANCE, CONNECT_IMPEDANCE)
-    assert m.eq_solref[eq, 0] == t.eq_solref[eq, 0]  # the model's own time constant kept
+    donor = int(t.eq_obj1id[eq])  # body1: the pin follows its anchor
+    # the pin is a share of its donor's mass, not an added one: the total is the twin's (float sum order only)
+    assert m.body_mass[pin] == pytest.approx(PIN_MASS_SHARE * t.body_mass[donor], rel=1e-12)
+    assert m.body_mass.sum() == pytest.approx(t.body_mass.sum(), rel=1e-12)
+    assert m.eq_obj2id[eq] == pin
+    # the moved connect keeps the twin's regularisation R and its stiffness and damping K, B at qpos0: the
+    # solver's numbers for the same rows, equal to rounding of the rescaled solimp and solref (1e-9)
+    rows = {}
+    for mm in (t, m):
+        d = mujoco.MjData(mm)
+        mujoco.mj_forward(mm, d)
+        sel = (d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY) & (d.efc_id[: d.nefc] == eq)
+        rows[mm is m] = (d.efc_R[: d.nefc][sel], d.efc_KBIP[: d.nefc][sel, :2])
+    np.testing.assert_allclose(rows[True][0], rows[False][0], rtol=1e-9)
+    np.testing.assert_allclose(rows[True][1], rows[False][1], rtol=1e-9)
     # the sizing reads the connect's force and the pin's mobility with the loop held: the native
     # model sizes the same bearing from the cycle's kinematics; 1 % is the two methods' agreement
     s = r.hinges["rod_slider"].sizing
@@ -77,6 +88,7 @@ def test_the_connect_gets_a_pin_and_keeps_every_body(loop):
     assert s.peak_load == pytest.approx(native.metadata["sizing"]["rod_slider"]["peak_load"], rel=1e-2)
     report = (out / "retrofit.md").read_text()
     assert "the pin `clr_rod_slider__pin`, a child of slider" in report
+    assert "+ pin is the original body in mass, centre of mass and inertia" in report
     assert "the connect `rod_slider` ties body1's anchor to the pin" in report
 
 
@@ -152,7 +164,10 @@ def test_a_pin_inside_the_tree_with_a_hinge_in_ring_mode(tmp_path):
     from clearance.retrofit import SineControl
 
     spec = mujoco.MjSpec.from_string(_FOUR_BAR)
-    numerics = RetrofitOptions(contact_mode="nominal", segments=128, sizing_duration=0.2, measure_speed=False)
+    # a coarse ring misses its ripple bound at the four-bar's light loads: kept, this test is about the edit
+    numerics = RetrofitOptions(
+        contact_mode="nominal", segments=128, sizing_duration=0.2, measure_speed=False, accept_inaccurate=True
+    )
     r = retrofit(spec, {"loop": RadialPlay(), "j1": RadialPlay()}, numerics)
     m = r.model
     joints = [mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j) for j in range(m.njnt)]
@@ -161,7 +176,10 @@ def test_a_pin_inside_the_tree_with_a_hinge_in_ring_mode(tmp_path):
     assert bodies == ["world", "crank", "coupler", "clr_loop__pin", "rocker"]
     # the keyframe's velocities land on their joints, the journals at rest in their bearings
     assert m.key_qvel[0].tolist() == [0, 0, 2, -2, 0, 0, 2]
-    assert m.body_mass[bodies.index("rocker")] == r.twin.body_mass[3]  # the shifted body kept its mass
+    # the shifted body (the connect's body1, the pin's donor) and its pin weigh what it weighed (rounding only)
+    pin_and_rocker = m.body_mass[bodies.index("rocker")] + m.body_mass[bodies.index("clr_loop__pin")]
+    assert pin_and_rocker == pytest.approx(r.twin.body_mass[3], rel=1e-12)
+    assert m.body_mass[bodies.index("coupler")] == r.twin.body_mass[2]  # the pin's parent keeps its own
     assert r.hinges["loop"].elements.segments and m.nplugin == 0  # a ring: stock MuJoCo
     out = tmp_path / "four_bar"
     write_retrofit(r, out)
@@ -180,8 +198,10 @@ def test_cli_retrofits_a_connect(tmp_path, capsys):
     model.write_text(_FOUR_BAR)
     argv = ["retrofit", str(model), "--joint", "loop:clearance_mm=0.2", "--out", str(tmp_path / "out")]
     argv += ["--contact-mode", "nominal", "--segments", "64", "--sizing-duration-s", "0.05", "--no-speed"]
+    argv += ["--accept-inaccurate"]  # the coarse ring misses its ripple bound: kept, with a warning
     assert main(argv) == 0
-    assert "loop: c = 0.2 mm" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "loop: c = 0.2 mm" in out and "warning: accuracy not met, kept with --accept-inaccurate" in out
     written = mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "model.xml"))  # stock MuJoCo opens it
     assert mujoco.mj_name2id(written, mujoco.mjtObj.mjOBJ_BODY, "clr_loop__pin") >= 0
 
@@ -202,7 +222,9 @@ _TWO_PINS = """<mujoco model="two_pins"><option timestep="0.001"/><worldbody>
 def test_two_pins_on_one_body_in_any_order(order):
     """Two connects closing on one body get their pins in the order given; the coordinate map follows it
     (before, pins at one point of the joint order were mapped by name and the edit stopped on its own check)."""
-    numerics = RetrofitOptions(contact_mode="nominal", segments=64, sizing_duration=0.05, measure_speed=False)
+    numerics = RetrofitOptions(
+        contact_mode="nominal", segments=64, sizing_duration=0.05, measure_speed=False, accept_inaccurate=True
+    )
     r = retrofit(mujoco.MjSpec.from_string(_TWO_PINS), {name: RadialPlay() for name in order}, numerics)
     m = r.model
     pins = [n for n in order if n.startswith("c")]

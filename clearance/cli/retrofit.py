@@ -167,6 +167,12 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     )
     p.add_argument("--no-speed", action="store_true", help="do not measure the speed cost")
     p.add_argument(
+        "--accept-inaccurate",
+        action="store_true",
+        help="keep a ring that misses its stated accuracy (its force ripple bound, its calibration's goals) with a "
+        "warning in the console and the report, instead of refusing it",
+    )
+    p.add_argument(
         "--backlash-stop",
         default="calibrated",
         choices=("calibrated", "recipe", "exact"),
@@ -381,6 +387,8 @@ def _command_line(args: argparse.Namespace) -> str:
             parts.append(f"{flag} {value:g}" if isinstance(value, float) else f"{flag} {value}")
     if args.no_speed:
         parts.append("--no-speed")
+    if args.accept_inaccurate:
+        parts.append("--accept-inaccurate")
     return " ".join(parts)
 
 
@@ -402,6 +410,7 @@ def command(args: argparse.Namespace) -> int:
         control=SineControl(args.sine_amplitude, args.sine_frequency_hz),  # or the control file, read below
         sizing_duration=args.sizing_duration_s,
         measure_speed=not args.no_speed,
+        accept_inaccurate=args.accept_inaccurate,
     )
     out = check_folder(args.out, "--out")
     path = Path(args.model)
@@ -439,5 +448,7 @@ def command(args: argparse.Namespace) -> int:
         )
     for note in result.notes:
         print(f"note: {note}")
+    for warning in result.warnings:
+        print(f"warning: {warning}")
     print("wrote " + ", ".join(str(p) for p in paths.values()))
     return 0

@@ -39,9 +39,11 @@ import numpy as np
 from clearance.contact_calibration.torsional_stop import OMEGA_H
 from clearance.contact_plugin import require
 from clearance.contact_plugin.backlash_stop import add_backlash_stop
-from clearance.retrofit.backlash_stop import Band, BandStop, calibrate_stops
-from clearance.retrofit.coordinates import joint_index_map
+from clearance.retrofit.backlash_stop import Band, BandStop, calibrate_stops, stop_note
+from clearance.retrofit.conventions import check_conventions
+from clearance.retrofit.coordinates import extend_paired_keyframes, joint_index_map
 from clearance.retrofit.elements import add_builtin_class
+from clearance.retrofit.masses import FROZEN_NOTE, check_masses, freeze_inertials
 from clearance.retrofit.play import PREFIX, Backlash, RetrofitError
 from clearance.retrofit.selection import check_not_retrofitted, compile_model, model_label
 
@@ -194,19 +196,19 @@ def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backl
     return actuated
 
 
-def _move_sensors(spec: mujoco.MjSpec, hinge: str, play: Backlash) -> tuple[str, ...]:
-    """Point the hinge's sensors that belong on the motor side at its motor hinge; their labels.
+def _move_sensors(spec: mujoco.MjSpec, hinge: str, play: Backlash) -> dict[int, str]:
+    """Point the hinge's sensors that belong on the motor side at its motor hinge; their ids -> labels.
 
     jointactuatorfrc always moves (the actuators are on the motor hinge now; on the link it
     would read 0); jointpos and jointvel move where ``play.sensors`` is 'motor'.
     """
     kinds = _ACTUATOR_SENSORS + (_STATE_SENSORS if play.sensors == "motor" else ())
-    moved = []
+    moved = {}
     for k, sensor in enumerate(spec.sensors):
         if sensor.objtype == mujoco.mjtObj.mjOBJ_JOINT and sensor.objname == hinge and sensor.type in kinds:
             sensor.objname = motor_joint_name(hinge)
-            moved.append(sensor.name or f"#{k}")
-    return tuple(moved)
+            moved[k] = sensor.name or f"#{k}"
+    return moved
 
 
 def _reference_inertia(twin: mujoco.MjModel, dof: int) -> float:
@@ -239,13 +241,14 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
 
     work = spec.copy()
     compile_model(work)  # the work spec's elements get the twin's ids
+    frozen = freeze_inertials(work, twin, adds_bodies=True, cuts_pins=False)
     old_joints = list(work.joints)
     bodies = {int(b.id): b for b in work.bodies}
     old_bodies = sorted(bodies)
     actuators = {int(a.id): a for a in work.actuators}
     cls = add_builtin_class(work)
     pending: dict[str, tuple[str, Backlash, str, str, str, tuple[str, ...], float, str]] = {}
-    sensors: dict[str, tuple[str, ...]] = {}
+    sensors: dict[str, dict[int, str]] = {}
     for name, play in joints.items():
         j = mujoco.mj_name2id(twin, mujoco.mjtObj.mjOBJ_JOINT, name)
         body = int(twin.jnt_bodyid[j])
@@ -271,16 +274,19 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
             ipos=[0.0, 0.0, 0.0],
             iquat=[1.0, 0.0, 0.0, 0.0],  # set, so the MJCF writer writes the inertial
         )
+        # angles as the hinge's own spec holds them, in the model's units (degrees under
+        # <compiler angle="degree"/>): the motor's range and reference angle compile as the hinge's
         motor.add_joint(
             cls,
             name=motor_joint_name(name),
             type=_HINGE,
             pos=twin.jnt_pos[j],
             axis=twin.jnt_axis[j],
+            ref=hinge.ref,
             armature=armature,
             damping=damping,
             limited=mujoco.mjtLimited.mjLIMITED_TRUE if twin.jnt_limited[j] else mujoco.mjtLimited.mjLIMITED_FALSE,
-            range=twin.jnt_range[j],
+            range=list(hinge.range),
             solref_limit=twin.jnt_solref[j],
             solimp_limit=twin.jnt_solimp[j],
             margin=twin.jnt_margin[j],
@@ -332,18 +338,19 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
             tendon.solref_limit = list(stop.solref)
             tendon.solimp_limit = list(stop.solimp)
     work.option.timestep = timestep
-    done = {name: BacklashHinge(*pending[name], stops[name], sensors[name]) for name in joints}
-    nkeys = _extend_keyframes(work, twin, kinematic, old_joints, done)
+    done = {name: BacklashHinge(*pending[name], stops[name], tuple(sensors[name].values())) for name in joints}
+    qmap, vmap = joint_index_map(twin, kinematic, [int(j.id) for j in old_joints])
+    pairs = [(int(kinematic.joint(h.name).id), int(kinematic.joint(h.motor_joint).id)) for h in done.values()]
+    nkeys = extend_paired_keyframes(work, twin, kinematic, qmap, vmap, pairs)
     model = compile_model(work)
-    kept = np.array([int(bodies[b].id) for b in old_bodies])
-    if not np.array_equal(model.body_mass[kept], twin.body_mass) or not np.array_equal(
-        model.body_inertia[kept], twin.body_inertia
-    ):
-        raise RuntimeError("backlash changed a body's mass or inertia")
+    motor_ids = [int(model.body(h.motor_body).id) for h in done.values()]
+    check_masses(twin, model, [int(bodies[b].id) for b in old_bodies], light=motor_ids, light_mass=MOTOR_MASS)
+    motors = {int(twin.joint(n).id): int(model.joint(h.motor_joint).id) for n, h in done.items()}
+    check_conventions(twin, model, qmap, vmap, motors=motors, moved_sensors=[k for s in sensors.values() for k in s])
     notes = [
         f"hinge '{h.name}': actuators {', '.join(h.actuators)} moved to '{h.motor_joint}' (armature "
         f"{h.motor_armature:.4g} kg m^2, {h.armature_source}); dead band +-{h.backlash.half_width:.4g} rad by the "
-        f"{_band_note(h)}, {_stop_note(h.stop)}; "
+        f"{_band_note(h)}, {stop_note(h.stop)}; "
         + (
             f"sensors on the motor side: {', '.join(h.moved_sensors)}"
             if h.moved_sensors
@@ -351,6 +358,8 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
         )
         for h in done.values()
     ]
+    if frozen:
+        notes.append(FROZEN_NOTE)
     if timestep < twin.opt.timestep:
         notes.append(
             f"time step lowered from {twin.opt.timestep:g} s to {timestep:g} s for the calibrated or exact stops "
@@ -365,52 +374,3 @@ def _band_note(h: BacklashHinge) -> str:
     if h.stop.kind == "exact":
         return f"tendon '{h.tendon}' (unlimited, the band's angle) closed by plugin '{stop_plugin_name(h.name)}'"
     return f"limit of tendon '{h.tendon}'"
-
-
-def _stop_note(stop: BandStop) -> str:
-    """One line on a band's stop."""
-    if stop.kind == "exact":
-        return (
-            "the mesh law itself, exact (compiled plugin clearance.backlash_stop; effective inertia "
-            f"{stop.inertia:.4g} kg m^2)"
-        )
-    if stop.fit is None:
-        return f"MuJoCo's default stop (the recipe, not calibrated; effective inertia {stop.inertia:.4g} kg m^2)"
-    worst = max(max(abs(r.peak_torque_err), abs(r.restitution_err)) for r in stop.fit.rows)
-    return (
-        f"stop calibrated to K = {stop.fit.law.stiffness:.4g} N m/rad, e = {stop.fit.law.restitution:g} at J = "
-        f"{stop.inertia:.4g} kg m^2 over {stop.fit.speeds[0]:.3g}..{stop.fit.speeds[-1]:.3g} rad/s (worst error "
-        f"{100 * worst:.2f} %)"
-    )
-
-
-def _extend_keyframes(
-    work: mujoco.MjSpec,
-    twin: mujoco.MjModel,
-    model: mujoco.MjModel,
-    old_joints: list[mujoco.MjsJoint],
-    done: Mapping[str, BacklashHinge],
-) -> int:
-    """Rewrite each keyframe's qpos and qvel for ``model``: the twin's values where its joints now
-    sit, each motor angle and speed equal to its load's (the band centred). Returns the count."""
-    qmap, vmap = joint_index_map(twin, model, [int(j.id) for j in old_joints])
-    motors = [
-        (int(model.jnt_qposadr[model.joint(h.name).id]), int(model.jnt_qposadr[model.joint(h.motor_joint).id]))
-        for h in done.values()
-    ]
-    dmotors = [
-        (int(model.jnt_dofadr[model.joint(h.name).id]), int(model.jnt_dofadr[model.joint(h.motor_joint).id]))
-        for h in done.values()
-    ]
-    for k, key in enumerate(work.keys):
-        qpos = model.qpos0.copy()
-        qvel = np.zeros(model.nv)
-        qpos[qmap] = twin.key_qpos[k]
-        qvel[vmap] = twin.key_qvel[k]
-        for load, motor in motors:
-            qpos[motor] = qpos[load]
-        for load, motor in dmotors:
-            qvel[motor] = qvel[load]
-        key.qpos = qpos
-        key.qvel = qvel
-    return len(work.keys)

@@ -52,6 +52,7 @@ __all__ = [
     "calibrate_stops",
     "impact_speed",
     "pose_inertias",
+    "stop_note",
 ]
 
 FALLBACK_IMPACT_SPEED = 1.0
@@ -239,3 +240,20 @@ def calibrate_stops(model: mujoco.MjModel, bands: Mapping[str, Band]) -> tuple[f
             "calibrated", inertia[name], invweight, speed, source, fit, solref, stop_solimp(), ranges[name], poses
         )
     return step, out
+
+
+def stop_note(stop: BandStop) -> str:
+    """One line on a band's stop (for notes and reports)."""
+    if stop.kind == "exact":
+        return (
+            "the mesh law itself, exact (compiled plugin clearance.backlash_stop; effective inertia "
+            f"{stop.inertia:.4g} kg m^2)"
+        )
+    if stop.fit is None:
+        return f"MuJoCo's default stop (the recipe, not calibrated; effective inertia {stop.inertia:.4g} kg m^2)"
+    worst = max(max(abs(r.peak_torque_err), abs(r.restitution_err)) for r in stop.fit.rows)
+    return (
+        f"stop calibrated to K = {stop.fit.law.stiffness:.4g} N m/rad, e = {stop.fit.law.restitution:g} at J = "
+        f"{stop.inertia:.4g} kg m^2 over {stop.fit.speeds[0]:.3g}..{stop.fit.speeds[-1]:.3g} rad/s (worst error "
+        f"{100 * worst:.2f} %)"
+    )

@@ -14,7 +14,14 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
-__all__ = ["CoordinateMap", "coordinate_map", "check_map", "extend_keyframes", "joint_index_map"]
+__all__ = [
+    "CoordinateMap",
+    "coordinate_map",
+    "check_map",
+    "extend_keyframes",
+    "extend_paired_keyframes",
+    "joint_index_map",
+]
 
 _NQ = {
     mujoco.mjtJoint.mjJNT_FREE: 7,
@@ -167,3 +174,31 @@ def extend_keyframes(
         key.qpos = list(cmap.model_qpos(twin.key_qpos[k], offsets))
         key.qvel = list(cmap.model_qvel(twin.key_qvel[k]))
     return len(keys)
+
+
+def extend_paired_keyframes(
+    spec: mujoco.MjSpec,
+    twin: mujoco.MjModel,
+    model: mujoco.MjModel,
+    qmap: np.ndarray,
+    vmap: np.ndarray,
+    pairs: Sequence[tuple[int, int]],
+) -> int:
+    """Rewrite each keyframe of ``spec`` for ``model``, where each pair's second hinge follows its first.
+
+    Each keyframe's qpos and qvel become full vectors of ``model``: the twin's values where its
+    joints now sit (``qmap``, ``vmap``: `joint_index_map`), every other coordinate at qpos0 and
+    at rest, then each second hinge of ``pairs`` (joint ids in ``model``: a backlash motor after
+    its load) at its first's angle and speed (the band centred). Returns the count.
+    """
+    for k, key in enumerate(spec.keys):
+        qpos = model.qpos0.copy()
+        qvel = np.zeros(model.nv)
+        qpos[qmap] = twin.key_qpos[k]
+        qvel[vmap] = twin.key_qvel[k]
+        for first, second in pairs:
+            qpos[model.jnt_qposadr[second]] = qpos[model.jnt_qposadr[first]]
+            qvel[model.jnt_dofadr[second]] = qvel[model.jnt_dofadr[first]]
+        key.qpos = qpos
+        key.qvel = qvel
+    return len(spec.keys)

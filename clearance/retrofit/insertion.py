@@ -29,7 +29,9 @@ __all__ = [
     "prefix_of",
     "add_slides_and_sites",
     "add_bearing",
+    "add_bearing_frame",
     "add_exact_contact",
+    "bearing_frame_name",
     "exact_contact_name",
 ]
 
@@ -70,7 +72,30 @@ class PlayElements:
     sensors: list[str] = field(default_factory=list)
 
 
-def _site(body: mujoco.MjsBody, name: str, place: Placement, default: mujoco.MjsDefault) -> None:
+def bearing_frame_name(hinge: str) -> str:
+    """The `<frame>` at a hinge's bearing centre that holds its ring and bearing site."""
+    return f"{prefix_of(hinge)}__bearing_frame"
+
+
+def add_bearing_frame(
+    body: mujoco.MjsBody, prefix: str, frame: BearingFrame, default: mujoco.MjsDefault
+) -> mujoco.MjsFrame:
+    """Nested `<frame>` elements in ``body`` along ``frame.chain`` (the innermost at the bearing centre
+    with the bearing axes, named ``<prefix>__bearing_frame``) and the bearing site at its origin."""
+    holder: mujoco.MjsBody | mujoco.MjsFrame = body
+    for k, place in enumerate(frame.chain):
+        last = k == len(frame.chain) - 1
+        holder = holder.add_frame(
+            name=f"{prefix}__bearing_frame" if last else "",
+            pos=list(place.origin),
+            quat=list(place.quat or (1.0, 0.0, 0.0, 0.0)),
+        )
+    _site(holder, f"{prefix}__bearing", Placement((0.0, 0.0, 0.0)), default)
+    assert isinstance(holder, mujoco.MjsFrame)  # a bearing frame's chain is never empty
+    return holder
+
+
+def _site(body: mujoco.MjsBody | mujoco.MjsFrame, name: str, place: Placement, default: mujoco.MjsDefault) -> None:
     body.add_site(
         default=default,
         name=name,
@@ -108,7 +133,7 @@ def add_slides_and_sites(
         spec, hinge, prefix, frame.journal.point(0.0, 0.0), frame.axes[:, :2].T, default
     )
     _site(journal_body, f"{prefix}__journal", frame.journal, default)
-    _site(bearing_body, f"{prefix}__bearing", frame.bearing, default)
+    add_bearing_frame(bearing_body, prefix, frame, default)
     return PlayElements(
         name,
         (slides[0].name, slides[1].name),
@@ -123,22 +148,24 @@ def add_bearing(
     spec: mujoco.MjSpec,
     elements: PlayElements,
     journal_body: mujoco.MjsBody,
-    bearing_body: mujoco.MjsBody,
     frame: BearingFrame,
     ring: RingGeometry,
     options: ModelOptions,
     friction: float,
     default: mujoco.MjsDefault,
 ) -> RingElements:
-    """Add the journal, ring, pairs and sensors of one hinge; fills ``elements``' names."""
+    """Add the journal, ring, pairs and sensors of one hinge; fills ``elements``' names.
+
+    The ring goes into the hinge's bearing-centred frame (`add_bearing_frame`, added with the sites).
+    """
     prefix = prefix_of(elements.hinge)
     added = add_journal_and_bearing(
         spec,
         journal_body,
-        bearing_body,
+        spec.frame(bearing_frame_name(elements.hinge)),  # the bearing-centred frame: 6 digits hold the ring
         prefix,
         frame.journal,
-        frame.bearing,
+        Placement((0.0, 0.0, 0.0)),
         ring,
         options,
         friction,

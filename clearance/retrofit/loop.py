@@ -9,52 +9,53 @@ compiled exact contact), so the slides' coordinates are the journal's eccentrici
 bearing frame. The axis is that of a hinge of body2, or else of body1 (the first one in the
 body's joint order), at qpos0.
 
-The pin is the one body a retrofit adds. MuJoCo refuses a moving body without mass, so it
-gets `PIN_MASS` and `PIN_INERTIA` (MuJoCo's floor is 1e-15), and its translational inertia
-is the slides' armature: `PIN_ARMATURE_FRACTION` of body1's subtree mass, added to the mass
-the journal carries. With so light a pin the connect's default soft impedance (0.9-0.95)
-would let the pin run from the anchor (the constraint's force per metre scales with the
-row's mass); the moved connect gets `CONNECT_IMPEDANCE`, MuJoCo's largest, so the loop
-closes as stiffly as before. Measured on the slider-crank's rod_slider (c = 0.5 mm, steel,
-exact contact, 2 us, a 2.1e-4 kg pin): the journal orbit within 0.40 % of c of the native
-clearance model over 0.8 ms, the first impact on the same step (tests/test_retrofit_loop.py);
-20 ms ran without a warning with the armature anywhere from 1e-5 to 1e-2 kg. With the
-connect's default impedance the orbit was 48 % of c off at 0.5 ms (3 us, 1e-3 kg pin), and
-an armature below 1e-3 kg diverged.
+The pin is the one body a retrofit adds, and it is a real share of a link's mass: a point mass
+cut from its donor at the connect's anchor (`clearance.retrofit.masses.split_point_mass`), the
+donor being body1 (the pin follows body1's anchor, so donor + pin move as the original body) or
+body2 where body1 is the world. A near-massless pin gave the connect's row an inverse weight
+of 1e12: MuJoCo's regularisation R = (1 - d)/d Â grew with it and the loop opened by a
+quarter of a metre while the contact pushed the pin about.
+
+The moved connect keeps the twin's softness (`connect_softness`): MuJoCo gives a soft
+constraint the static compliance R/K per newton of load (K, B from solref and solimp's d_width),
+so the impedance is raised until R(r) = (1 - d(r))/d(r) Â is the twin's at the connect's new
+Â, and the time constant (or the direct-mode stiffness and damping) is rescaled so that K and
+B stay. Where the impedance would have to exceed MuJoCo's largest, 0.9999, it stops there and
+the report says how much softer the connect is.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
 from clearance.retrofit.frames import BearingFrame, in_plane_axes, placement
-from clearance.retrofit.insertion import PlayElements, prefix_of
+from clearance.retrofit.insertion import PlayElements, add_bearing_frame, prefix_of
+from clearance.retrofit.masses import PIN_INERTIA, Inertial, PointMassSplit, split_point_mass
 from clearance.retrofit.play import RetrofitError
 
 __all__ = [
-    "CONNECT_IMPEDANCE",
-    "PIN_ARMATURE_FRACTION",
-    "PIN_INERTIA",
-    "PIN_MASS",
+    "MAX_IMPEDANCE",
+    "ConnectSoftness",
+    "Pin",
     "add_pin",
     "check_connect",
     "connect_frame",
     "connect_load",
+    "connect_softness",
+    "pin_donor",
     "pin_insertion_joint",
+    "pin_share",
+    "soften_like_twin",
 ]
 
-PIN_MASS = 1e-12
-"""Mass of the pin body [kg]: the smallest MuJoCo compiles comfortably above its 1e-15 floor."""
+MAX_IMPEDANCE = 0.9999
+"""MuJoCo's largest impedance d (mjMAXIMP)."""
 
-PIN_INERTIA = 1e-12
-"""Rotational inertia of the pin body [kg m^2] (the pin does not turn; MuJoCo requires one)."""
-
-PIN_ARMATURE_FRACTION = 1e-3
-"""Armature of the pin's slides as a fraction of body1's subtree mass [-]: the journal's added mass."""
-
-CONNECT_IMPEDANCE = 0.9999
-"""solimp d0 = d_width of the moved connect: MuJoCo's largest impedance."""
+_MIN_IMPEDANCE = 1e-4
+"""MuJoCo's smallest impedance d (mjMINIMP)."""
 
 _OBJ = mujoco.mjtObj
 
@@ -110,7 +111,8 @@ def connect_frame(model: mujoco.MjModel, data: mujoco.MjData, eq: int, axis_join
     hb = int(model.jnt_bodyid[axis_joint])
     axis_world = data.xmat[hb].reshape(3, 3) @ np.asarray(model.jnt_axis[axis_joint], dtype=float)
     axes = in_plane_axes(r2.T @ axis_world)
-    return BearingFrame(placement(np.zeros(3), axes), placement(origin, axes), axes, axes)
+    bearing = placement(origin, axes)
+    return BearingFrame(placement(np.zeros(3), axes), bearing, axes, axes, (bearing,))
 
 
 def connect_load(data: mujoco.MjData, eq: int, body2: int, frame: BearingFrame) -> np.ndarray:
@@ -144,12 +146,21 @@ def pin_insertion_joint(model: mujoco.MjModel, body2: int) -> int:
     return int(model.njnt)
 
 
+def pin_donor(model: mujoco.MjModel, eq: int) -> tuple[int, np.ndarray]:
+    """(the body a connect's pin takes its mass from, the anchor in that body's frame [m]): body1, or
+    body2 where body1 is the world."""
+    b1 = int(model.eq_obj1id[eq])
+    if b1 > 0:
+        return b1, np.asarray(model.eq_data[eq, :3], dtype=float)
+    return int(model.eq_obj2id[eq]), np.asarray(model.eq_data[eq, 3:6], dtype=float)
+
+
 def add_pin(
     spec: mujoco.MjSpec,
     name: str,
     body2: mujoco.MjsBody,
     frame: BearingFrame,
-    armature: float,
+    split: PointMassSplit,
     default: mujoco.MjsDefault,
 ) -> PlayElements:
     """Add the pin to ``body2`` and move connect ``name`` to it; returns the names added.
@@ -159,14 +170,14 @@ def add_pin(
         name: the connect.
         body2: its body2 in the spec (the bearing's body).
         frame: its bearing frame (`connect_frame`).
-        armature: the slides' armature [kg] (the pin's translational inertia).
+        split: the pin's share of its donor's mass (`pin_share`); the caller writes the donor's remainder.
         default: the retrofit's default class.
     """
     prefix = prefix_of(name)
     connect = spec.equality(name)
     origin = [float(v) for v in frame.bearing.origin]
     pin = body2.add_body(name=f"{prefix}__pin", pos=origin)
-    pin.mass = PIN_MASS
+    pin.mass = split.pin_mass
     pin.inertia = [PIN_INERTIA] * 3
     pin.explicitinertial = True
     pin.ipos, pin.iquat = [0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0]  # set, so the MJCF writer writes the inertial
@@ -176,23 +187,13 @@ def add_pin(
             name=f"{prefix}__{k}",
             type=mujoco.mjtJoint.mjJNT_SLIDE,
             axis=[float(v) for v in frame.axes[:, i]],
-            armature=armature,
         )
         for i, k in enumerate(("x", "y"))
     ]
     size = [0.001, 0.0, 0.0]
     pin.add_site(default=default, name=f"{prefix}__journal", size=size, group=3, **frame.journal.orientation())
-    body2.add_site(
-        default=default,
-        name=f"{prefix}__bearing",
-        pos=frame.bearing.point(0.0, 0.0),
-        size=size,
-        group=3,
-        **frame.bearing.orientation(),
-    )
+    add_bearing_frame(body2, prefix, frame, default)
     connect.name2 = pin.name
-    solimp = list(connect.solimp)
-    connect.solimp = [CONNECT_IMPEDANCE, CONNECT_IMPEDANCE, *solimp[2:]]
     return PlayElements(
         name,
         (slides[0].name, slides[1].name),
@@ -201,3 +202,105 @@ def add_pin(
         pin.name,
         body2.name or f"#{body2.id}",
     )
+
+
+def pin_share(twin: mujoco.MjModel, eq: int, donors: dict[int, Inertial]) -> PointMassSplit:
+    """The pin's point mass cut from the connect's donor (`pin_donor`) at the anchor.
+
+    Args:
+        twin: the unmodified model.
+        eq: the connect.
+        donors: body id -> its mass properties after the cuts so far (updated: two pins may
+            share a donor).
+    """
+    donor, point = pin_donor(twin, eq)
+    now = donors.get(donor) or Inertial.of_body(twin, donor)
+    split = split_point_mass(donor, now, point, label=mujoco.mj_id2name(twin, _OBJ.mjOBJ_BODY, donor) or f"#{donor}")
+    donors[donor] = split.remainder
+    return split
+
+
+@dataclass(frozen=True)
+class ConnectSoftness:
+    """The moved connect's solver parameters and how far they keep the twin's softness.
+
+    Attributes:
+        solimp: (5,) written. solref: (2,) written.
+        inverse_weight: Â of the connect's rows in the twin and with the pin (translational
+            ``body_invweight0`` sums) [1/kg].
+        softer: R(r) of the retrofitted connect over the twin's [-] (1: kept; above 1 where the
+            impedance stopped at `MAX_IMPEDANCE`).
+    """
+
+    solimp: tuple[float, ...]
+    solref: tuple[float, float]
+    inverse_weight: tuple[float, float]
+    softer: float
+
+
+def _impedance_for(d: float, scale: float) -> float:
+    """The impedance whose (1 - d)/d is ``scale`` times ``d``'s, within MuJoCo's range."""
+    rho = (1.0 - d) / d * scale
+    return min(max(1.0 / (1.0 + rho), _MIN_IMPEDANCE), MAX_IMPEDANCE)
+
+
+def connect_softness(twin: mujoco.MjModel, model: mujoco.MjModel, eq: int, step: float) -> ConnectSoftness:
+    """The solimp and solref that give the moved connect ``eq`` the twin's R(r), K and B (module docstring).
+
+    K and B are the twin's at the time step ``step`` both models run at (MuJoCo raises a time
+    constant below 2 ``step`` to 2 ``step`` unless the model disables that): a rescaled time
+    constant that would fall below it is written in direct mode (negative solref) instead.
+
+    Args:
+        twin: the unmodified model.
+        model: the edited model with the pin (its solimp and solref not yet set).
+        eq: the connect's id (the same in both).
+        step: the time step [s].
+    """
+    a_old = float(twin.body_invweight0[twin.eq_obj1id[eq], 0] + twin.body_invweight0[twin.eq_obj2id[eq], 0])
+    a_new = float(model.body_invweight0[model.eq_obj1id[eq], 0] + model.body_invweight0[model.eq_obj2id[eq], 0])
+    scale = a_old / a_new
+    old = [float(v) for v in twin.eq_solimp[eq]]
+    d0, dw = (min(max(d, _MIN_IMPEDANCE), MAX_IMPEDANCE) for d in old[:2])
+    n0, nw = _impedance_for(d0, scale), _impedance_for(dw, scale)
+    softer = max(((1 - n0) / n0) / ((1 - d0) / d0 * scale), ((1 - nw) / nw) / ((1 - dw) / dw * scale))
+    ref = [float(v) for v in twin.eq_solref[eq]]
+    safe = not int(twin.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_REFSAFE)
+    if ref[0] > 0:  # K = 1/(dmax^2 tc^2 zeta^2), B = 2/(dmax tc): the same K and B at dmax = nw
+        tc = max(ref[0], 2 * step) if safe else ref[0]
+        solref = (tc * dw / nw, ref[1])
+        if safe and solref[0] < 2 * step:  # MuJoCo would raise it: direct mode, which it leaves alone
+            k, b = 1 / (dw * tc * ref[1]) ** 2, 2 / (dw * tc)
+            solref = (-k * nw**2, -b * nw)
+    else:  # direct: K = -S/dmax^2, B = -D/dmax
+        solref = (ref[0] * (nw / dw) ** 2, ref[1] * nw / dw)
+    return ConnectSoftness((n0, nw, *old[2:]), solref, (a_old, a_new), softer)
+
+
+@dataclass(frozen=True)
+class Pin:
+    """What a loop closure's pin took and how its connect was set.
+
+    Attributes:
+        share: its point mass cut from the donor. softness: the moved connect's solver parameters.
+    """
+
+    share: PointMassSplit
+    softness: ConnectSoftness
+
+
+def soften_like_twin(
+    spec: mujoco.MjSpec, twin: mujoco.MjModel, model: mujoco.MjModel, name: str, share: PointMassSplit, step: float
+) -> Pin:
+    """Write the moved connect ``name``'s solimp and solref that keep the twin's softness (`connect_softness`).
+
+    Args:
+        spec: the spec being edited. twin: the unmodified model. model: ``spec`` compiled with the pin.
+        name: the connect. share: its pin's share of the donor's mass. step: the time step [s].
+    """
+    eq = mujoco.mj_name2id(twin, _OBJ.mjOBJ_EQUALITY, name)
+    soft = connect_softness(twin, model, eq, step)
+    connect = spec.equality(name)
+    connect.solimp = list(soft.solimp)
+    connect.solref = list(soft.solref)
+    return Pin(share, soft)

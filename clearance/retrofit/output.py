@@ -4,29 +4,34 @@
 (the unmodified model with the same asset-path fixes, for comparison runs) and
 ``retrofit.md`` (every change; `clearance.retrofit.report`) and ``retrofit.json`` (what a run
 of the model reads: `clearance.retrofit.manifest`). The written model is compiled
-again from its file before the report is written, so a model that would not load is never
-reported as done.
+again from its file before the report is written, and its rings are measured there against
+their nominal geometry (`check_rings`), so a model that would not load, or whose rings MuJoCo's
+6-digit writer bent, is never reported as done.
 """
 
 from __future__ import annotations
 
 import os
+from collections.abc import Iterable
 from pathlib import Path
 
 import mujoco
+import numpy as np
 
 from clearance.results import atomic_write_text
 from clearance.retrofit.assets import relocate_assets
 from clearance.retrofit.backlash import BacklashRetrofit
 from clearance.retrofit.backlash_report import backlash_report
 from clearance.retrofit.manifest import MANIFEST_FILE, BacklashRecord, HingeRecord, RetrofitManifest
-from clearance.retrofit.pipeline import Retrofit
+from clearance.retrofit.pipeline import Retrofit, RetrofittedHinge
 from clearance.retrofit.report import retrofit_report
 
 __all__ = [
     "MODEL_FILE",
     "TWIN_FILE",
     "REPORT_FILE",
+    "RING_TOLERANCE",
+    "check_rings",
     "backlash_manifest_of",
     "manifest_of",
     "write_backlash",
@@ -71,16 +76,54 @@ def write_retrofit(
         "report": out / REPORT_FILE,
         "manifest": out / MANIFEST_FILE,
     }
-    changes = _write_models(result.spec, result.twin_spec, src, out, paths)
+    changes, written = _write_models(result.spec, result.twin_spec, src, out, paths)
+    check_rings(written, result.hinges.values(), str(paths["model"]))
     atomic_write_text(paths["manifest"], manifest_of(result).to_json())
     atomic_write_text(paths["report"], retrofit_report(result, source=source, command=command, asset_changes=changes))
     return paths
 
 
+RING_TOLERANCE = 0.01
+"""Largest error of a written ring, as a fraction of its clearance c [-]: each segment's implied
+clearance (its distance from the bearing centre less its radius and the journal's) and the
+journal's offset from the bearing centre at qpos0, read back from the file."""
+
+
+def check_rings(model: mujoco.MjModel, hinges: Iterable[RetrofittedHinge], where: str) -> None:
+    """Check each ring of ``model`` (a written model, read back) against its nominal geometry.
+
+    Raises:
+        RuntimeError: a segment's implied clearance, or the journal's offset at qpos0, is off by more
+            than `RING_TOLERANCE` of c (naming the hinge and the numbers).
+    """
+    data = mujoco.MjData(model)
+    mujoco.mj_kinematics(model, data)
+    for h in hinges:
+        if h.ring is None:
+            continue
+        el, c = h.elements, h.play.clearance.radial_clearance
+        site = model.site(el.bearing_site).id
+        centre, axes = data.site_xpos[site], data.site_xmat[site].reshape(3, 3)
+        journal = model.geom(el.journal_geom).id
+        r_j = float(model.geom_size[journal, 0])
+        local = np.array([axes.T @ (data.geom_xpos[model.geom(g).id] - centre) for g in el.segments])
+        sizes = np.array([model.geom_size[model.geom(g).id, 0] for g in el.segments])
+        implied = np.hypot(local[:, 0], local[:, 1]) - sizes - r_j
+        offset = float(np.linalg.norm((axes.T @ (data.geom_xpos[journal] - centre))[:2]))
+        error = max(float(np.max(np.abs(implied - c))), float(np.max(np.abs(local[:, 2]))), offset)
+        if error > RING_TOLERANCE * c:
+            raise RuntimeError(
+                f"{where}: the ring of hinge '{h.name}' is {error * 1e6:.3g} um off its nominal geometry (implied "
+                f"clearance {implied.min() * 1e6:.4g}..{implied.max() * 1e6:.4g} um for c = {c * 1e6:.4g} um, journal "
+                f"{offset * 1e6:.3g} um off centre), more than {RING_TOLERANCE:.0%} of c"
+            )
+
+
 def _write_models(
     spec: mujoco.MjSpec, twin_spec: mujoco.MjSpec, src: Path, out: Path, paths: dict[str, Path]
-) -> list[str]:
-    """Write the edited model and its twin (asset folders rewritten for ``out``); the model's asset changes.
+) -> tuple[list[str], mujoco.MjModel]:
+    """Write the edited model and its twin (asset folders rewritten for ``out``); (the model's asset
+    changes, the model read back from its file).
 
     Raises:
         RuntimeError: the written model does not compile from its file.
@@ -93,10 +136,10 @@ def _write_models(
             changes = found
         atomic_write_text(paths[role], copy.to_xml())
     try:
-        mujoco.MjModel.from_xml_path(str(paths["model"]))
+        written = mujoco.MjModel.from_xml_path(str(paths["model"]))
     except ValueError as err:
         raise RuntimeError(f"the written model {paths['model']} does not compile: {err}") from None
-    return changes
+    return changes, written
 
 
 def write_backlash(
@@ -119,7 +162,7 @@ def write_backlash(
     out.mkdir(parents=True, exist_ok=True)
     src = Path(source_dir if source_dir is not None else (result.twin_spec.modelfiledir or "."))
     paths = {"model": out / MODEL_FILE, "original": out / TWIN_FILE, "report": out / REPORT_FILE}
-    changes = _write_models(result.spec, result.twin_spec, src, out, paths)
+    changes, _ = _write_models(result.spec, result.twin_spec, src, out, paths)
     paths["manifest"] = out / MANIFEST_FILE
     atomic_write_text(paths["manifest"], backlash_manifest_of(result).to_json())
     atomic_write_text(paths["report"], backlash_report(result, source=source, command=command, changes=changes))

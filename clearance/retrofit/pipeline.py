@@ -11,26 +11,25 @@ speed cost (`speed`).
 
 from __future__ import annotations
 
-import contextlib
 import dataclasses
-import time
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 
 import mujoco
-import numpy as np
 
-from clearance.contact_calibration.fit import GOALS
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.spec import ring_geometry
 from clearance.model import Joint, JointType
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
+from clearance.retrofit.accuracy import Miss, fit_miss, refuse_or_warn, ripple_miss
 from clearance.retrofit.contact import PlayContact, play_contact, row_inverse_weight, write_pair_contact
+from clearance.retrofit.conventions import check_conventions
 from clearance.retrofit.coordinates import CoordinateMap, check_map, coordinate_map, extend_keyframes
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.frames import BearingFrame, bearing_frame
 from clearance.retrofit.insertion import PlayElements, add_bearing, add_exact_contact, add_slides_and_sites
-from clearance.retrofit.loop import PIN_ARMATURE_FRACTION, add_pin, connect_frame, pin_insertion_joint
+from clearance.retrofit.loop import Pin, add_pin, connect_frame, pin_insertion_joint, pin_share, soften_like_twin
+from clearance.retrofit.masses import FROZEN_NOTE, Inertial, PointMassSplit, check_masses, freeze_inertials
 from clearance.retrofit.motion import Motion, twin_motion
 from clearance.retrofit.play import RadialPlay, RetrofitError, RetrofitOptions
 from clearance.retrofit.selection import Hinge, compile_model, model_label, select_hinges
@@ -42,7 +41,7 @@ from clearance.retrofit.sizing import (
     effective_masses,
     size_play,
 )
-from clearance.retrofit.speed import SpeedCost, measure_speed
+from clearance.retrofit.speed import Clock, SpeedCost, measure_speed
 
 __all__ = ["RetrofittedHinge", "Retrofit", "retrofit", "INTEGRATORS", "EXACT_SOURCE"]
 
@@ -75,6 +74,8 @@ class RetrofittedHinge:
             [N/m^1.5] and no damping parameter; the plugin computes the law's own).
         model_options: the options its ring was built and calibrated with (segments, geoms,
             time step, integrator, impedance, contact mode).
+        pin: a loop closure's pin (its share of the donor's mass, its connect's softness); None
+            for a hinge.
     """
 
     name: str
@@ -87,6 +88,7 @@ class RetrofittedHinge:
     sizing: PlaySizing
     contact: PlayContact
     model_options: ModelOptions
+    pin: Pin | None = None
 
 
 @dataclass
@@ -106,9 +108,11 @@ class Retrofit:
         motion: the unmodified model's sizing motion.
         keyframes: keyframes extended.
         speed: the speed cost (None when not measured).
-        notes: remarks for the report (a segment rule's fallback, warnings of the motion).
+        notes: remarks for the report (warnings of the motion, frozen inertials).
         timings: wall time per phase [s]: 'checks', 'sizing motion', 'spec edit and
             compiles', 'effective masses', 'segment rule', 'contact parameters', 'speed'.
+        warnings: rings kept although they miss their stated accuracy (with
+            ``options.accept_inaccurate``; `clearance.retrofit.accuracy`), one line each.
     """
 
     spec: mujoco.MjSpec
@@ -125,6 +129,7 @@ class Retrofit:
     speed: SpeedCost | None = None
     notes: list[str] = field(default_factory=list)
     timings: dict[str, float] = field(default_factory=dict)
+    warnings: list[str] = field(default_factory=list)
 
     @property
     def wall_time(self) -> float:
@@ -143,14 +148,6 @@ def _check_plays(joints: Mapping[str, RadialPlay]) -> None:
 def _spec_bodies(spec: mujoco.MjSpec) -> dict[int, mujoco.MjsBody]:
     """Spec bodies by the id the last compile gave them."""
     return {int(b.id): b for b in spec.bodies}
-
-
-def _mass_properties(model: mujoco.MjModel, bodies: np.ndarray | None = None) -> np.ndarray:
-    """Masses, inertias and inertial frames of ``bodies`` (ids; default all) in one array."""
-    b = np.arange(model.nbody) if bodies is None else bodies
-    return np.concatenate(
-        [model.body_mass[b], model.body_inertia[b].ravel(), model.body_ipos[b].ravel(), model.body_iquat[b].ravel()]
-    )
 
 
 def _in_model(hinge: Hinge, bodies: Mapping[int, mujoco.MjsBody], spec: mujoco.MjSpec, added: PlayElements) -> Hinge:
@@ -197,7 +194,7 @@ def retrofit(
     """
     options = options or RetrofitOptions()
     exact = options.contact_mode is ContactMode.EXACT
-    clock = _Clock()
+    clock = Clock()
     with clock("checks"):
         _check_plays(joints)
         if exact:
@@ -233,17 +230,24 @@ def retrofit(
     with clock("spec edit and compiles"):
         work = spec.copy()
         compile_model(work)  # gives the work spec's elements the compiled ids the twin has
+        pinned = any(h.is_connect for h in hinges)  # a pin is the one body, and the one inertial, a retrofit adds
+        if freeze_inertials(work, twin, adds_bodies=pinned, cuts_pins=pinned):
+            notes.append(FROZEN_NOTE)
         bodies = _spec_bodies(work)
         cls = add_builtin_class(work)
         elements: dict[str, PlayElements] = {}
+        donors: dict[int, Inertial] = {}
+        shares: dict[str, PointMassSplit] = {}
         for h in hinges:
             if h.parent_id not in bodies:
                 raise RetrofitError(f"the parent body of hinge '{h.name}' is not in the spec of {model_label(spec)}")
             if h.is_connect:
-                armature = PIN_ARMATURE_FRACTION * float(twin.body_subtreemass[h.child_id])
-                elements[h.name] = add_pin(work, h.name, bodies[h.parent_id], frames[h.name], armature, cls)
+                shares[h.name] = pin_share(twin, h.equality_id, donors)
+                elements[h.name] = add_pin(work, h.name, bodies[h.parent_id], frames[h.name], shares[h.name], cls)
                 continue
             elements[h.name] = add_slides_and_sites(work, work.joint(h.name), bodies[h.parent_id], frames[h.name], cls)
+        for donor, remainder in donors.items():
+            remainder.apply(bodies[donor])
         cmap = coordinate_map(
             twin,
             {h.name: h.joint_id for h in hinges if not h.is_connect},
@@ -258,21 +262,22 @@ def retrofit(
     with clock("effective masses"):
         masses = effective_masses(kinematic, cmap, list(in_model.values()), frames, motion)
     sizings: dict[str, PlaySizing] = {}
+    flat = options.segment_geom is GeomType.BOX
     with clock("segment rule"):
         for h in hinges:
-            sizings[h.name], rule_notes = size_play(
+            sizings[h.name] = size_play(
                 joints[h.name].clearance,
                 motion.load_size(h.name),
                 masses[h.name],
                 segments=0 if exact else options.segments,  # the exact contact has no ring
                 ripple_limit=options.ripple_limit,
-                flat=options.segment_geom is GeomType.BOX,
+                flat=flat,
             )
-            notes += [f"hinge '{h.name}': {n}" for n in rule_notes]
     h_model = float(twin.opt.timestep)
     step = options.timestep if options.timestep is not None else choose_time_step(sizings, h_model)
     for name, s in sizings.items():
         check_time_step(name, s, step)
+    pins = {n: soften_like_twin(work, twin, kinematic, n, share, step) for n, share in shares.items()}
 
     integrator = INTEGRATORS.get(mujoco.mjtIntegrator(int(twin.opt.integrator)), "implicitfast")
     if options.contact_mode is ContactMode.CALIBRATED and integrator not in ("implicitfast", "euler"):
@@ -280,37 +285,46 @@ def retrofit(
             f"the model integrates with {integrator}; the ring's contact is fitted in the one-bearing impact scene, "
             "which integrates with implicitfast (its explicit contact step is Euler's and implicitfast's alike)"
         )
+    options_of = {h.name: _model_options(options, sizings[h.name], step, integrator) for h in hinges}
+    rings = {h.name: _ring(joints[h.name], sizings[h.name].segments, options_of[h.name]) for h in hinges if not exact}
+    misses = [
+        miss
+        for name, ring in rings.items()
+        if (miss := ripple_miss(name, ring, sizings[name], options.ripple_limit, flat=flat)) is not None
+    ]
+    warnings = refuse_or_warn(misses, options.accept_inaccurate)  # before the fits: refusing costs nothing
     done: dict[str, RetrofittedHinge] = {}
+    fit_misses: list[Miss] = []
     for h in hinges:
-        play, sizing = joints[h.name], sizings[h.name]
-        model_options = ModelOptions(
-            segments=sizing.segments or None,  # None: the exact contact, no ring
-            journal_geom=options.journal_geom,
-            segment_geom=options.segment_geom,
-            timestep=step,
-            integrator=integrator,
-            contact_mode=options.contact_mode,
-            ripple_limit=options.ripple_limit,
-            impedance=options.impedance,
-        )
+        play, sizing, model_options = joints[h.name], sizings[h.name], options_of[h.name]
         if exact:
             with clock("spec edit and compiles"):
                 add_exact_contact(work, elements[h.name], play.clearance)
             contact = PlayContact(ContactParameters(sizing.stiffness, 0.0, source=EXACT_SOURCE))
             done[h.name] = RetrofittedHinge(
-                h.name, play, h, frames[h.name], elements[h.name], None, masses[h.name], sizing, contact, model_options
+                h.name,
+                play,
+                h,
+                frames[h.name],
+                elements[h.name],
+                None,
+                masses[h.name],
+                sizing,
+                contact,
+                model_options,
+                pins.get(h.name),
             )
             continue
-        ring = _ring(play, sizing.segments, model_options)
+        ring = rings[h.name]
         with clock("contact parameters"):
             contact = play_contact(play.clearance, ring, sizing, model_options, use_cache=options.use_cache)
-        notes += _accuracy_notes(h.name, contact, ring, sizing)
+        if (miss := fit_miss(h.name, contact, ring, sizing)) is not None:
+            fit_misses.append(miss)
         with clock("spec edit and compiles"):
             added = add_bearing(
                 work,
                 elements[h.name],
                 work.body(elements[h.name].journal_body) if h.is_connect else work.joint(h.name).parent,
-                bodies[h.parent_id],
                 frames[h.name],
                 ring,
                 model_options,
@@ -320,51 +334,61 @@ def retrofit(
             a_hat = row_inverse_weight(kinematic, in_model[h.name].child_id, in_model[h.name].parent_id)
             write_pair_contact(added.pairs, contact.parameters, a_hat, play.clearance.radial_clearance)
         done[h.name] = RetrofittedHinge(
-            h.name, play, h, frames[h.name], elements[h.name], ring, masses[h.name], sizing, contact, model_options
+            h.name,
+            play,
+            h,
+            frames[h.name],
+            elements[h.name],
+            ring,
+            masses[h.name],
+            sizing,
+            contact,
+            model_options,
+            pins.get(h.name),
         )
+    warnings += refuse_or_warn(fit_misses, options.accept_inaccurate)
     with clock("spec edit and compiles"):
         work.option.timestep = step
         model = compile_model(work)
-    kept = np.array([int(b.id) for _, b in sorted(bodies.items())])
-    if not np.array_equal(_mass_properties(model, kept), _mass_properties(twin)):
-        raise RuntimeError("the retrofit changed a body's mass or inertia (new geoms must be massless)")
+    check_masses(
+        twin,
+        model,
+        [int(b.id) for _, b in sorted(bodies.items())],
+        [(p.share.donor, int(model.body(elements[name].journal_body).id)) for name, p in pins.items()],
+    )
+    check_conventions(twin, model, cmap.qpos, cmap.qvel)
     speed = None
     if options.measure_speed:
         with clock("speed"):
             speed = SpeedCost(measure_speed(twin, options.control), measure_speed(model, options.control))
     return Retrofit(
-        work, model, twin_spec, twin, done, options, integrator, step, cmap, motion, nkeys, speed, notes, clock.times
+        work,
+        model,
+        twin_spec,
+        twin,
+        done,
+        options,
+        integrator,
+        step,
+        cmap,
+        motion,
+        nkeys,
+        speed,
+        notes,
+        clock.times,
+        warnings,
     )
 
 
-def _accuracy_notes(name: str, contact: PlayContact, ring: RingGeometry, sizing: PlaySizing) -> list[str]:
-    """A note when the calibrated ring misses the fit's accuracy goals at some impact speed."""
-    cal = contact.calibration
-    if cal is None:
-        return []
-    missed = [row for row in cal.rows if not row.meets_goals()]
-    if not missed:
-        return []
-    force = max((row.peak_force_worst for row in cal.rows), key=abs)
-    rest = max((row.restitution_worst for row in cal.rows), key=abs)
-    return [
-        f"hinge '{name}': the calibrated ring misses the fit's accuracy goals at {len(missed)} of {len(cal.rows)} "
-        f"impact speeds (worst peak force {force:+.1%}, restitution {rest:+.3f}; goals "
-        f"{GOALS['peak_force']:.0%} and {GOALS['restitution']:g}); the ring's polygon error c (pi/N)^2 / 2 is "
-        f"{ring.polygon_error * 1e6:.3g} um against a typical penetration of {sizing.typical_penetration * 1e6:.3g} um"
-    ]
-
-
-class _Clock:
-    """Wall time per named phase, summed over its entries."""
-
-    def __init__(self) -> None:
-        self.times: dict[str, float] = {}
-
-    @contextlib.contextmanager
-    def __call__(self, phase: str) -> Iterator[None]:
-        t0 = time.perf_counter()
-        try:
-            yield
-        finally:
-            self.times[phase] = self.times.get(phase, 0.0) + time.perf_counter() - t0
+def _model_options(options: RetrofitOptions, sizing: PlaySizing, step: float, integrator: str) -> ModelOptions:
+    """The options one bearing's ring is built and calibrated with."""
+    return ModelOptions(
+        segments=sizing.segments or None,  # None: the exact contact, no ring
+        journal_geom=options.journal_geom,
+        segment_geom=options.segment_geom,
+        timestep=step,
+        integrator=integrator,
+        contact_mode=options.contact_mode,
+        ripple_limit=options.ripple_limit,
+        impedance=options.impedance,
+    )

@@ -302,6 +302,8 @@ class RetrofitOptions:
         sizing_duration: how long that motion is run [s].
         measure_speed: measure steps per second of both models (the speed cost).
         use_cache: read and write stored calibrations.
+        accept_inaccurate: keep a ring that misses its stated accuracy (the ripple bound, the
+            calibration's goals: `clearance.retrofit.accuracy`) with a warning instead of refusing it.
     """
 
     contact_mode: ContactMode = ContactMode.CALIBRATED
@@ -315,6 +317,7 @@ class RetrofitOptions:
     sizing_duration: float = 1.0
     measure_speed: bool = True
     use_cache: bool = True
+    accept_inaccurate: bool = False
 
     def __post_init__(self) -> None:
         try:

@@ -2,10 +2,16 @@
 
 from __future__ import annotations
 
+import math
+
 import mujoco
 import numpy as np
 
-from clearance.retrofit.loop import CONNECT_IMPEDANCE, PIN_ARMATURE_FRACTION, PIN_INERTIA, PIN_MASS
+from clearance.contact_calibration.fit import GOALS
+from clearance.options import ContactMode
+from clearance.retrofit.insertion import bearing_frame_name
+from clearance.retrofit.loop import MAX_IMPEDANCE
+from clearance.retrofit.masses import PIN_INERTIA, body_label
 from clearance.retrofit.pipeline import Retrofit, RetrofittedHinge
 from clearance.retrofit.play import DEFAULT_CLASS, SineControl
 from clearance.retrofit.sizing import STEP_OMEGA_H
@@ -50,30 +56,41 @@ def _hinge_rows(r: Retrofit) -> list[str]:
     return rows
 
 
-def _pin(h: RetrofittedHinge, model: mujoco.MjModel) -> list[str]:
+def _pin(h: RetrofittedHinge, r: Retrofit) -> list[str]:
     """The pin and the moved connect of a loop closure."""
-    el, axes = h.elements, h.frame.axes
-    slide = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_JOINT, el.slides[0])
-    armature = float(model.dof_armature[model.jnt_dofadr[slide]])
+    el, axes, pin = h.elements, h.frame.axes, h.pin
+    assert pin is not None  # a loop closure always has its pin
+    share, soft = pin.share, pin.softness
+    donor = body_label(r.twin, share.donor)
+    kept = (
+        "the twin's regularisation R = (1 - d)/d Â and its K and B kept"
+        if soft.softer <= 1 + 1e-9
+        else f"{soft.softer:.3g}x the twin's regularisation: the impedance stopped at MuJoCo's largest, "
+        f"{MAX_IMPEDANCE:g}"
+    )
     return [
         f"- body: the pin `{el.journal_body}`, a child of {el.bearing_body} at the connect's anchor "
-        f"{_vec(np.asarray(h.frame.bearing.origin))} ({el.bearing_body} frame), mass {_g(PIN_MASS)} kg and inertia "
-        f"{_g(PIN_INERTIA)} kg m² (MuJoCo needs a moving body to have them): the one body and mass a retrofit adds",
+        f"{_vec(np.asarray(h.frame.bearing.origin))} ({el.bearing_body} frame): a point mass of "
+        f"{_g(share.pin_mass)} kg "
+        f"({_g(share.share * 100)} % of body {donor}'s mass, cut from it at the anchor: {donor} now weighs "
+        f"{_g(share.remainder.mass)} kg, and {donor} + pin is the original body in mass, centre of mass and inertia, "
+        f"checked) with an isotropic inertia of {_g(PIN_INERTIA)} kg m² (MuJoCo needs one; cut from {donor} too)",
         f"- joints: slides `{el.slides[0]}` (axis {_vec(axes[:, 0])}) and `{el.slides[1]}` (axis {_vec(axes[:, 1])}) "
-        f"in the pin, armature {_g(armature)} kg each ({_g(PIN_ARMATURE_FRACTION * 100)} % of the subtree mass of the "
-        "connect's body1): the journal's added mass",
-        f"- equality: the connect `{h.name}` ties body1's anchor to the pin instead of {el.bearing_body}; its solimp "
-        f"d0 = d_width = {_g(CONNECT_IMPEDANCE)} (MuJoCo's largest: a light pin would let a softer connect open), "
-        "every other attribute kept",
+        "in the pin, no armature",
+        f"- equality: the connect `{h.name}` ties body1's anchor to the pin instead of {el.bearing_body}; solimp "
+        f"({', '.join(_g(v) for v in soft.solimp)}) and solref ({', '.join(_g(v) for v in soft.solref)}): the pin "
+        "raises "
+        f"the rows' inverse weight Â from {_g(soft.inverse_weight[0])} to {_g(soft.inverse_weight[1])} 1/kg, so the "
+        f"impedance is raised with it ({kept}); every other attribute kept",
     ]
 
 
-def _added(h: RetrofittedHinge, model: mujoco.MjModel) -> list[str]:
+def _added(h: RetrofittedHinge, r: Retrofit) -> list[str]:
     el = h.elements
     n = len(el.segments)
     axes = h.frame.axes
     joints = (
-        _pin(h, model)
+        _pin(h, r)
         if h.hinge.is_connect
         else [
             f"- joints: slides `{el.slides[0]}` (axis {_vec(axes[:, 0])}) and `{el.slides[1]}` (axis "
@@ -87,7 +104,10 @@ def _added(h: RetrofittedHinge, model: mujoco.MjModel) -> list[str]:
         "",
         *joints,
         f"- sites: `{el.journal_site}` (body {el.journal_body}), `{el.bearing_site}` (body {el.bearing_body}, at "
-        f"{_vec(np.asarray(h.frame.bearing.origin))} in its frame), both with the bearing frame's axes",
+        f"{_vec(np.asarray(h.frame.bearing.origin))} in its frame), both with the bearing frame's axes; the bearing "
+        f"site{' and the ring' if h.ring is not None else ''} in the frame `{bearing_frame_name(h.name)}` centred on "
+        "the bearing (MuJoCo writes 6 digits: the ring's offsets from its centre keep them to 1e-8 m; checked after "
+        "writing, within 1 % of c)",
     ]
     if h.ring is None:
         return [
@@ -112,8 +132,8 @@ def _added(h: RetrofittedHinge, model: mujoco.MjModel) -> list[str]:
 def _sizing_rows(r: Retrofit) -> list[str]:
     rows = [
         "| hinge | median load [N] | peak load [N] | effective mass [kg] (min–max) | impact speed [m/s] "
-        "| typical penetration [µm] | divergence bound [µm] | segments | ω [rad/s] | ω h |",
-        "|---|---|---|---|---|---|---|---|---|---|",
+        "| typical penetration [µm] | divergence bound [µm] | segments | force ripple | ω [rad/s] | ω h |",
+        "|---|---|---|---|---|---|---|---|---|---|---|",
     ]
     for h in r.hinges.values():
         s = h.sizing
@@ -121,7 +141,8 @@ def _sizing_rows(r: Retrofit) -> list[str]:
         rows.append(
             f"| {h.name} | {_g(s.median_load)} | {_g(s.peak_load)} | {_g(s.effective_mass)} ({_g(lo)}–{_g(hi)}) "
             f"| {_g(s.impact_speed)} | {_g(s.typical_penetration * 1e6)} | {_g(s.penetration_limit * 1e6)} "
-            f"| {s.segments} | {_g(s.omega)} | {_g(s.omega * r.timestep, 3)} |"
+            f"| {s.segments} | {'–' if math.isnan(s.ripple) else f'{s.ripple:.1%}'} | {_g(s.omega)} "
+            f"| {_g(s.omega * r.timestep, 3)} |"
         )
     return rows
 
@@ -171,7 +192,7 @@ def _kept(r: Retrofit, asset_changes: list[str]) -> list[str]:
     return [
         f"- bodies: {t.nbody} → {m.nbody}; every body's mass, inertia and inertial frame compiled equal "
         "(checked: new geoms and sites add no mass)"
-        + (f"; the pins of loop closures are the bodies added ({_g(PIN_MASS)} kg each)" if m.nbody > t.nbody else ""),
+        + ("; the pins of loop closures are the bodies added, each cut from its donor" if m.nbody > t.nbody else ""),
         f"- joints: {t.njnt} → {m.njnt} (+2 slides per hinge or pin); nq {t.nq} → {m.nq}, nv {t.nv} → {m.nv}",
         f"- geoms: {t.ngeom} → {m.ngeom} (+{n_geoms}); sites: {t.nsite} → {m.nsite} (+{2 * nh}); "
         f"pairs: {t.npair} → {m.npair}",
@@ -183,6 +204,27 @@ def _kept(r: Retrofit, asset_changes: list[str]) -> list[str]:
         f"- integrator: {r.integrator} (kept); time step {_g(float(t.opt.timestep))} s → "
         f"{_g(r.timestep)} s; every other option kept",
     ]
+
+
+def _accuracy(r: Retrofit) -> list[str]:
+    """What each ring states, and the rings kept although they miss it."""
+    if r.options.contact_mode is ContactMode.EXACT:
+        return []
+    stated = (
+        f"Each ring states its accuracy: a force ripple with journal direction below {r.options.ripple_limit:.1%} over "
+        "half to twice its typical penetration"
+        + (
+            f", and a calibration within {GOALS['peak_force']:.0%} in peak force, {GOALS['max_penetration']:.0%} in "
+            f"penetration, {GOALS['duration']:.0%} in duration and {GOALS['restitution']:g} in restitution at every "
+            "fitted impact speed"
+            if r.options.contact_mode is ContactMode.CALIBRATED
+            else ""
+        )
+        + "; a ring that misses is refused unless --accept-inaccurate keeps it."
+    )
+    if not r.warnings:
+        return [stated, ""]
+    return [stated, "", "**Accuracy not met:**", "", *[f"- {w}" for w in r.warnings], ""]
 
 
 def retrofit_report(r: Retrofit, *, source: str = "", command: str = "", asset_changes: list[str] | None = None) -> str:
@@ -207,13 +249,14 @@ def retrofit_report(r: Retrofit, *, source: str = "", command: str = "", asset_c
         f"Ring mode (portable MJCF, stock MuJoCo), contact {r.options.contact_mode.value}; "
         f"{r.options.journal_geom.value} journal, {r.options.segment_geom.value} segments.",
         "",
+        *_accuracy(r),
         "## Hinges given radial play",
         "",
         *_hinge_rows(r),
         "",
         "## Added",
         "",
-        *[line for h in r.hinges.values() for line in _added(h, r.model)],
+        *[line for h in r.hinges.values() for line in _added(h, r)],
         "## Sizing",
         "",
         f"From {len(r.motion.times)} steps ({_g(len(r.motion.times) * h0, 3)} s) of the unmodified model at its own "

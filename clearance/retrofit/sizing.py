@@ -32,7 +32,7 @@ import numpy as np
 
 from clearance.contact_calibration.effective_mass import LIGHT_LOAD
 from clearance.contact_calibration.laws import bearing_stiffness, contact_omega
-from clearance.mjcf.bearing import choose_segments
+from clearance.mjcf.bearing import RingGeometry, band_ripple, choose_segments
 from clearance.model import Clearance
 from clearance.retrofit.coordinates import CoordinateMap
 from clearance.retrofit.frames import BearingFrame
@@ -88,6 +88,8 @@ class PlaySizing:
         penetration_limit: divergence bound [m].
         segments: ring segment count N.
         omega: contact frequency sqrt(k_t / m) at the divergence bound [rad/s].
+        ripple: the ring's force ripple over half to twice the typical penetration [-]
+            (`clearance.mjcf.bearing.band_ripple`); NaN without a ring (the exact contact).
     """
 
     stiffness: float
@@ -100,6 +102,7 @@ class PlaySizing:
     penetration_limit: float
     segments: int
     omega: float
+    ripple: float = math.nan
 
 
 def _equality_rows(model: mujoco.MjModel, data: mujoco.MjData) -> np.ndarray:
@@ -187,14 +190,17 @@ def size_play(
     segments: int | None,
     ripple_limit: float,
     flat: bool,
-) -> tuple[PlaySizing, list[str]]:
-    """Size one bearing; returns the sizing and the segment rule's notes (a light load's fallback).
+) -> PlaySizing:
+    """Size one bearing.
+
+    Where no segment count meets the ripple bound (light loads) the rule's least rippled count is
+    kept and its ripple recorded: `clearance.retrofit.accuracy` refuses or warns about it.
 
     Args:
         clearance: the play's physics.
         loads: (n,) in-plane load sizes over the motion [N].
         mass: its effective mass over the motion.
-        segments: a fixed segment count, or None for the ripple rule.
+        segments: a fixed segment count (0: no ring, the exact contact), or None for the ripple rule.
         ripple_limit: the rule's largest force ripple [-].
         flat: box segments (flat faces).
     """
@@ -208,20 +214,16 @@ def size_play(
     v = math.sqrt(2 * fpk * c / m)
     d_imp = (5 * m * v**2 / (4 * K)) ** 0.4
     lim = 4 * max(d_imp, (fpk / K) ** (2 / 3))
-    notes: list[str] = []
     if segments is None:
-        with warnings.catch_warnings(record=True) as caught:
-            warnings.simplefilter("always")
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", RuntimeWarning)  # the rule's fallback: the ripple miss reports it
             segments = choose_segments(clearance.bearing_radius, c, dtyp, ripple_limit=ripple_limit, flat=flat)
-        # the rule speaks to a mechanism's user; a retrofit's chooses the count with --segments
-        notes = [
-            str(w.message).replace("give ModelOptions(segments=...)", "give --segments (RetrofitOptions(segments=...))")
-            for w in caught
-        ]
-    sizing = PlaySizing(
-        K, fmed, fmax, dtyp, v, m, (mass.minimum, mass.maximum), lim, segments, contact_omega(K, lim, m)
+    ripple = (
+        band_ripple(RingGeometry.make(clearance.bearing_radius, c, segments, flat=flat), dtyp) if segments else math.nan
     )
-    return sizing, notes
+    return PlaySizing(
+        K, fmed, fmax, dtyp, v, m, (mass.minimum, mass.maximum), lim, segments, contact_omega(K, lim, m), ripple
+    )
 
 
 def choose_time_step(sizings: Mapping[str, PlaySizing], model_step: float) -> float:

@@ -9,7 +9,9 @@ for its smaller time step and for its contact pairs.
 
 from __future__ import annotations
 
+import contextlib
 import time
+from collections.abc import Iterator
 from dataclasses import dataclass
 
 import mujoco
@@ -19,7 +21,7 @@ from mujoco import rollout
 from clearance.retrofit.motion import control_signal, fired_warnings, initial_data
 from clearance.retrofit.play import ControlTable, SineControl
 
-__all__ = ["MIN_WALL", "Speed", "SpeedCost", "measure_speed", "run_controlled"]
+__all__ = ["MIN_WALL", "Clock", "Speed", "SpeedCost", "measure_speed", "run_controlled"]
 
 MIN_WALL = 0.3
 """Wall time each model is stepped for when measuring its speed [s]."""
@@ -113,3 +115,18 @@ def measure_speed(model: mujoco.MjModel, control: SineControl | ControlTable, *,
     n = int(min(max(rate * min_wall, 200), 5_000_000))
     run = run_controlled(model, control, n)
     return Speed(n, run.wall, float(model.opt.timestep))
+
+
+class Clock:
+    """Wall time per named phase, summed over its entries (``with clock("phase"): ...``)."""
+
+    def __init__(self) -> None:
+        self.times: dict[str, float] = {}
+
+    @contextlib.contextmanager
+    def __call__(self, phase: str) -> Iterator[None]:
+        t0 = time.perf_counter()
+        try:
+            yield
+        finally:
+            self.times[phase] = self.times.get(phase, 0.0) + time.perf_counter() - t0

@@ -12,7 +12,10 @@ Rows are the sensor rows of `mujoco.rollout` (row i at t = i h, before step i). 
 carries every body's world pose (``body_poses``) and, per retrofitted hinge, the journal
 centre in its bearing frame (the eccentricity sensor; its rate is the slides' velocities,
 whose axes are the bearing frame's), the penetration |e| - c and the net contact force on
-the journal rotated into the bearing frame. The world positions of the sites asked for (a
+the journal rotated into the bearing frame; ``closure_violation`` is the largest residual of
+the model's connect equalities (`connect_residual`: what their constraint rows solve for; a
+loop closure given play ties body1's anchor to its pin, so it reads the connect's own
+softness and the journal's eccentricity reads the play). The world positions of the sites asked for (a
 site, or a body's origin where no site has the name: gymnasium's reacher names its tip a
 body) are ``outputs`` ``site/<name>/x``, ``/y`` and ``/z``. A backlash retrofit's run has no
 journals: per backlashed hinge its outputs ``backlash/<hinge>/angle`` (q_load - q_motor) and
@@ -43,6 +46,7 @@ from clearance.version import __version__
 
 __all__ = [
     "Retrofitted",
+    "connect_residual",
     "load_retrofitted",
     "point_of",
     "retrofitted",
@@ -265,6 +269,17 @@ def _first_bad(
     return None
 
 
+def connect_residual(model: mujoco.MjModel, data: mujoco.MjData, eq: int) -> float:
+    """|anchor on body1 - anchor on body2| of connect ``eq`` [m]: the size of the three constraint rows'
+    residual MuJoCo solves (``efc_pos``), from positions (after ``mj_kinematics``)."""
+    a, b = int(model.eq_obj1id[eq]), int(model.eq_obj2id[eq])
+    if model.eq_objtype[eq] == mujoco.mjtObj.mjOBJ_SITE:
+        return float(np.linalg.norm(data.site_xpos[a] - data.site_xpos[b]))
+    p1 = data.xpos[a] + data.xmat[a].reshape(3, 3) @ model.eq_data[eq, :3]
+    p2 = data.xpos[b] + data.xmat[b].reshape(3, 3) @ model.eq_data[eq, 3:6]
+    return float(np.linalg.norm(p1 - p2))
+
+
 class _Reader:
     """Sensor and position rows -> a `SimulationResult` chunk."""
 
@@ -294,6 +309,9 @@ class _Reader:
             hr.name: [int(model.jnt_dofadr[jid(mujoco.mjtObj.mjOBJ_JOINT, s)]) for s in hr.slides] for hr in hinges
         }
         self.points = [point_of(model, s) for s in self.sites]
+        self.connects = [
+            e for e in range(model.neq) if model.eq_type[e] == mujoco.mjtEq.mjEQ_CONNECT and model.eq_active0[e]
+        ]
 
     def read(self, times: np.ndarray, sens: np.ndarray, q: np.ndarray, v: np.ndarray) -> SimulationResult:
         model, data = self.model, self.data
@@ -301,13 +319,16 @@ class _Reader:
         poses = np.zeros((n, model.nbody, 7))
         site_pos = np.zeros((n, len(self.points), 3))
         bearing_rot = {name: np.zeros((n, 3, 3)) for name in self.bearing_site}
+        closure = np.zeros(n)
         for i in range(n):
             data.qpos[:] = q[i]
             if not np.isfinite(q[i]).all():
                 poses[i:] = np.nan
                 site_pos[i:] = np.nan
+                closure[i:] = np.nan
                 break
             mujoco.mj_kinematics(model, data)
+            closure[i] = max((connect_residual(model, data, e) for e in self.connects), default=0.0)
             poses[i, :, :3] = data.xpos
             poses[i, :, 3:] = data.xquat
             for k, (kind, pid) in enumerate(self.points):
@@ -340,7 +361,7 @@ class _Reader:
             drive_speed=np.zeros((n, 0)),
             drive_torque=np.zeros((n, 0)),
             link_poses=np.zeros((n, 0, 3)),
-            closure_violation=np.zeros(n),
+            closure_violation=closure,
             body_poses=poses,
         )
 
