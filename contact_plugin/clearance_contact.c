@@ -52,10 +52,15 @@
 // and J_t (tangential velocity) over the dofs at q_k:
 //   dv = h M^-1 J' f  +  other     (this joint's own force f, and every other force)
 // The other forces' change is taken from the last step (the recorded dv minus this joint's own
-// response there, kept in the state as nv numbers): constant extrapolation, which stays stable
-// whatever share of the own response the solver's constraints or an implicit actuator take
-// (M^-1 overstates the joint's mobility then, never understates it). This joint's own response is
-// taken at this step: with w_nn = J_n M^-1 J_n', w_nt = J_n M^-1 J_t', w_tt = J_t M^-1 J_t'.
+// response there, kept in the state as nv numbers), extrapolated as constant. This joint's own
+// response is taken at this step, with the model's equality constraints (loop closures, a pin
+// held by a connect) acting as the constraint solver solves them alone at this state:
+//   W = M^-1 - Y (J_c M^-1 J_c' + R)^-1 Y',  Y = M^-1 J_c'  (J_c, R: the equality rows)
+// and w_nn = J_n W J_n', w_nt = J_n W J_t', w_tt = J_t W J_t'. What the response leaves out (an
+// implicit actuator's damping, contact and limit rows) makes W overstate the joint's mobility,
+// never understate it; the rest comes through the constant extrapolation with one step's lag,
+// which stays stable whatever share it is (measured on the scalar model of the lag: spectral
+// radius below 1 for any share below 1; a linear extrapolation is not, beyond a share of 1/2).
 //
 // Normal force. Over the step the normal rate obeys r' = A - (g/h) r with r(0) = r0 = J_n qvel_k
 // (the sampled rate), h A = J_n other - h w_nn F_el + h w_nt F_t (the other forces, the elastic
@@ -207,6 +212,12 @@ typedef struct {
   mjtNum* own;               // this joint's velocity change over the step, h M^-1 J' f (nv)
   mjtNum* scratch;           // two bodies' Jacobians (12 nv)
   mjtNum* slot_vec;          // per cache slot: qvel, own and vec_n at the evaluation (3 nv each)
+  // the equality constraints' rows, at most eq_max of them (allocated in init)
+  int eq_max;
+  mjtNum* eq_rows;           // their Jacobian rows (eq_max nv)
+  mjtNum* eq_y;              // M^-1 of each row (eq_max nv)
+  mjtNum* eq_a;              // J_c M^-1 J_c' + R, then its Cholesky factor (eq_max^2)
+  mjtNum* eq_z;              // solves (2 eq_max)
 } jbData;
 
 
@@ -528,6 +539,74 @@ static void contact_rows(const mjModel* m, const mjData* d, const jbData* c, con
   }
 }
 
+// the equality constraints' rows at most: connect 3, weld 6, joint and tendon couplings 1 (a
+// model with other equality kinds, or more rows at run time, keeps the free response)
+static int equality_rows_max(const mjModel* m) {
+  int n = 0;
+  for (int i = 0; i < m->neq; i++) {
+    int type = m->eq_type[i];
+    if (type == mjEQ_CONNECT) n += 3;
+    else if (type == mjEQ_WELD) n += 6;
+    else if (type == mjEQ_JOINT || type == mjEQ_TENDON) n += 1;
+    else return -1;
+  }
+  return n;
+}
+
+// Turn the free responses M^-1 J_n' and M^-1 J_t' (in c->un, c->ut) into the responses with the
+// equality constraints' rows acting as the constraint solver solves them alone (their soft
+// dynamics at this state): u -= Y (J_c M^-1 J_c' + R)^-1 J_c u, Y = M^-1 J_c'. A loop closure
+// or a pin held by a connect then moves as the loop lets it, not as the free tree would.
+static void constrained_responses(const mjModel* m, mjData* d, jbData* c) {
+  int nv = m->nv, k = 0;
+  if (c->eq_max <= 0) {
+    return;
+  }
+  for (int r = 0; r < d->nefc; r++) {
+    if (d->efc_type[r] != mjCNSTR_EQUALITY) continue;
+    if (k == c->eq_max) return;  // more rows than the model declares: keep the free response
+    mjtNum* row = c->eq_rows + k * nv;
+    if (mj_isSparse(m)) {
+      mju_zero(row, nv);
+      int adr = d->efc_J_rowadr[r];
+      for (int j = 0; j < d->efc_J_rownnz[r]; j++) {
+        row[d->efc_J_colind[adr + j]] = d->efc_J[adr + j];
+      }
+    } else {
+      mju_copy(row, d->efc_J + r * nv, nv);
+    }
+    c->eq_z[k] = d->efc_R[r];  // R, held here until the factor is built
+    k++;
+  }
+  if (k == 0) {
+    return;
+  }
+  mj_solveM(m, d, c->eq_y, c->eq_rows, k);
+  for (int i = 0; i < k; i++) {
+    for (int j = 0; j <= i; j++) {
+      mjtNum a = mju_dot(c->eq_rows + i * nv, c->eq_y + j * nv, nv);
+      c->eq_a[i * k + j] = a;
+      c->eq_a[j * k + i] = a;
+    }
+    c->eq_a[i * k + i] += c->eq_z[i];
+  }
+  if (mju_cholFactor(c->eq_a, k, mjMINVAL) < k) {
+    return;  // singular: keep the free response
+  }
+  mjtNum* u[2] = {c->un, c->ut};
+  for (int v = 0; v < 2; v++) {
+    mjtNum* b = c->eq_z;
+    mjtNum* z = c->eq_z + c->eq_max;
+    for (int i = 0; i < k; i++) {
+      b[i] = mju_dot(c->eq_rows + i * nv, u[v], nv);
+    }
+    mju_cholSolve(z, c->eq_a, b, k);
+    for (int i = 0; i < k; i++) {
+      mju_addToScl(u[v], c->eq_y + i * nv, -z[i], nv);
+    }
+  }
+}
+
 // evaluate the contact at the current kinematics of d; pure in (d, state). For the
 // semi-implicit integrators it also fills the slot's vectors (jbData.vec, see store).
 static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jbEval* ev) {
@@ -595,6 +674,7 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
   if (instep) {
     contact_rows(m, d, c, n, ev->tangent, z, jn, jt, c->scratch);
     mj_solveM(m, d, c->un, jn, 2);  // un, ut: the two rows stored one after the other
+    constrained_responses(m, d, c);
     w_nn = mju_dot(jn, c->un, nv);
     w_nt = mju_dot(jn, c->ut, nv);
     w_tt = mju_dot(jt, c->ut, nv);
@@ -807,6 +887,7 @@ static int jb_nsensordata(const mjModel* m, int instance, int sensor_id) {
 static void jb_free(jbData* c) {
   free(c->sensor_adr);
   free(c->vec_n);
+  free(c->eq_rows);
   free(c);
 }
 
@@ -834,6 +915,19 @@ static int jb_init(const mjModel* m, mjData* d, int instance) {
   c->own = c->vec_n + 4 * nv;
   c->scratch = c->vec_n + 5 * nv;
   c->slot_vec = c->vec_n + 17 * nv;
+  c->eq_max = equality_rows_max(m);
+  if (c->eq_max > 0) {
+    int k = c->eq_max;
+    c->eq_rows = (mjtNum*)calloc((size_t)(2 * k * nv + k * k + 2 * k), sizeof(mjtNum));
+    if (!c->eq_rows) {
+      jb_free(c);
+      mju_warning(JB_NAME " instance %d: out of memory", instance);
+      return -1;
+    }
+    c->eq_y = c->eq_rows + k * nv;
+    c->eq_a = c->eq_y + k * nv;
+    c->eq_z = c->eq_a + k * k;
+  }
   d->plugin_data[instance] = (uintptr_t)c;
   return 0;
 }

@@ -198,20 +198,27 @@ def test_joint_lag_of_no_shift_and_of_a_run_without_steady_state():
 
 
 def test_joint_lag_agrees_in_sign_on_the_press():
-    """The seven-bar press, two revolutions at 40 us (one steady period; 3 s on 2 cores)."""
+    """The seven-bar press, two revolutions at 40 us and at 20 us (one steady period each)."""
     from clearance import ModelOptions, simulate
     from clearance.builders import seven_bar_press
 
     m = seven_bar_press()
-    options = ModelOptions(timestep=40e-6)
     period = m.drive_period
-    res = simulate(m, options=options, duration=2 * period)
-    ideal = simulate(m.ideal_twin(), options=options, duration=2 * period)
-    lag = joint_lag(res, ideal, "slider_y", startup=period)
-    # measured: -0.0217 ms (20 us and 3 us runs: -0.0215, -0.0217 ms); every signal negative
-    assert len({np.sign(v) for v in lag.per_signal.values()}) == 1
-    assert np.sign(lag.lag) == np.sign(lag.per_signal["slider_y"])
-    assert abs(lag.lag) < lag.bound and lag.resolved, lag.note
+    lags = []
+    for h in (40e-6, 20e-6):
+        options = ModelOptions(timestep=h)
+        res = simulate(m, options=options, duration=2 * period)
+        ideal = simulate(m.ideal_twin(), options=options, duration=2 * period)
+        lag = joint_lag(res, ideal, "slider_y", startup=period)
+        # displacement and velocity agree in sign with the joint estimate; the acceleration's own
+        # estimate follows the journals' contact-force ripple and is not asked to (its lag read
+        # +0.79 / -0.42 / +0.064 ms at 40 / 20 / 5 us, around a joint lag of -0.0217 ms)
+        assert np.sign(lag.per_signal["slider_y"]) == np.sign(lag.per_signal["slider_y_vel"]) == np.sign(lag.lag)
+        assert abs(lag.lag) < lag.bound
+        lags.append(lag.lag)
+    # the joint lag is the mechanism's, not the step's: measured -0.02165 / -0.02156 ms at 40 / 20
+    # us (-0.02177 ms at 5 us): within 1 % of each other; 5 % still catches a lag that moves with the step
+    assert lags[0] == pytest.approx(lags[1], rel=0.05)
 
 
 def test_contact_modes_classify_an_event_over_its_whole_duration():

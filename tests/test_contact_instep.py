@@ -26,6 +26,7 @@ from clearance.run.preparation import exact_contact_name, prepare
 from clearance.run.simulation import simulate_prepared, start_data
 
 LN = ContactLaw.LANKARANI_NIKRAVESH
+EULER = mujoco.mjtIntegrator.mjINT_EULER
 K = 6.61e10  # N/m^1.5, as test_contact_plugin's scene
 MU, V0, V1 = 0.3, 1e-4, 1e-3
 
@@ -49,21 +50,36 @@ def _rows(model: mujoco.MjModel, data: mujoco.MjData) -> tuple[np.ndarray, np.nd
     return n, t, jn, jt
 
 
-def _solve_m(model: mujoco.MjModel, data: mujoco.MjData, row: np.ndarray) -> np.ndarray:
-    out = np.zeros((1, model.nv))
-    mujoco.mj_solveM(model, data, out, row[None])
-    return out[0]
+def _response(model: mujoco.MjModel, data: mujoco.MjData, row: np.ndarray) -> np.ndarray:
+    """M^-1 row' with the equality rows acting as the solver solves them alone:
+    u - Y (J_c Y' + R)^-1 J_c u, Y = M^-1 J_c' (dense from the model's equality rows)."""
+    u = np.zeros((1, model.nv))
+    mujoco.mj_solveM(model, data, u, row[None])
+    eq = np.flatnonzero(data.efc_type[: data.nefc] == mujoco.mjtConstraint.mjCNSTR_EQUALITY)
+    if not len(eq):
+        return u[0]
+    jc = data.efc_J[: data.nefc * model.nv].reshape(data.nefc, model.nv)[eq]  # dense: nv < 60
+    y = np.zeros((len(eq), model.nv))
+    mujoco.mj_solveM(model, data, y, jc)
+    a = jc @ y.T + np.diag(data.efc_R[eq])
+    return u[0] - y.T @ np.linalg.solve(a, jc @ u[0])
 
 
 @needs_plugin
 @pytest.mark.parametrize(
-    "integrator",
-    [mujoco.mjtIntegrator.mjINT_EULER, mujoco.mjtIntegrator.mjINT_IMPLICITFAST],
-    ids=["euler", "implicitfast"],
+    ("integrator", "connect"),
+    [(mujoco.mjtIntegrator.mjINT_EULER, False), (mujoco.mjtIntegrator.mjINT_IMPLICITFAST, False), (None, True)],
+    ids=["euler", "implicitfast", "bearing held by a connect"],
 )
-def test_in_step_treatment_equals_its_formula(integrator: mujoco.mjtIntegrator) -> None:
+def test_in_step_treatment_equals_its_formula(integrator: mujoco.mjtIntegrator | None, connect: bool) -> None:
     h = 2e-6
-    model = _spec(LN, friction=MU, moving_bearing=True, timestep=h, integrator=integrator).compile()
+    spec = _spec(LN, friction=MU, moving_bearing=True, timestep=h, integrator=integrator or EULER)
+    if connect:  # the bearing pinned to the world 30 mm from its centre: it can only swing
+        anchor = [0.03, 0.0, 0.0] + [0.0] * 9
+        spec.add_equality(
+            type=mujoco.mjtEq.mjEQ_CONNECT, name1="bearing", objtype=mujoco.mjtObj.mjOBJ_BODY, data=anchor
+        )
+    model = spec.compile()
     data = mujoco.MjData(model)
     adr = attributes.state_address(model, "joint")
     y = attributes.sensor_offsets(model, "joint")
@@ -88,7 +104,7 @@ def test_in_step_treatment_equals_its_formula(integrator: mujoco.mjtIntegrator) 
         fn, ft, d, rate = (data.sensordata[y[k]] for k in fields)
 
         n, t, jn, jt = _rows(model, data)
-        un, ut = _solve_m(model, data, jn), _solve_m(model, data, jt)
+        un, ut = _response(model, data, jn), _response(model, data, jt)
         w_nn, w_nt, w_tt = jn @ un, jn @ ut, jt @ ut
         fel = K * d**1.5
         g = h * w_nn * fel * laws.hysteresis_factor(LN, 0.9) / vin
