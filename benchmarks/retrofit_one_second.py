@@ -60,6 +60,7 @@ def main_bench() -> None:
             for mode in MODES:
                 rdir, odir = Path(tmp) / f"{name}-{mode}", Path(tmp) / f"{name}-{mode}-run"
                 argv = ["retrofit", str(xml), "--out", str(rdir), "--youngs-modulus-gpa", "3", "--contact-mode", mode]
+                argv += ["--accept-inaccurate"]  # rings over their ripple bound at these loads: kept, the runs measured
                 for j in joints:
                     argv += ["--joint", j]
                 rc, text, t_fit = _cli(argv)

@@ -49,7 +49,9 @@ def _retrofitted(native_contact: ContactParameters | None) -> tuple[SimulationRe
     r = retrofit(
         spec,
         {"crank_rod": RadialPlay(dataclasses.replace(clearance, journal_link=None))},
-        RetrofitOptions(segments=104, timestep=options.timestep, control=drive, sizing_duration=0.012),
+        RetrofitOptions(
+            segments=104, timestep=options.timestep, control=drive, sizing_duration=0.012, accept_inaccurate=True
+        ),
     )
     with tempfile.TemporaryDirectory() as d:
         write_retrofit(r, d)

@@ -17,7 +17,7 @@ from cli_runner import run_cli as _cli
 from gym_assets import gym_model
 
 from clearance.retrofit import Backlash, RetrofitError
-from clearance.retrofit.backlash import MOTOR_MASS, add_backlash
+from clearance.retrofit.backlash import MOTOR_ARMATURE_FRACTION, MOTOR_MASS, add_backlash
 
 FLYWHEEL = """<mujoco model="flywheel"><option timestep="0.0005"/>
 <worldbody><body name="wheel" pos="0 0 0.1"><joint name="shaft" type="hinge" axis="0 0 1" armature="0.002"/>
@@ -121,8 +121,8 @@ def test_flywheel_without_armature_gets_a_stated_fraction():
     spec = mujoco.MjSpec.from_string(FLYWHEEL.replace(' armature="0.002"', ""))
     out = add_backlash(spec, {"shaft": Backlash.from_arcmin(30)})
     h = out.hinges["shaft"]
-    # 1 % of the wheel's inertia m r^2 / 2 = 0.005 kg m^2
-    assert h.motor_armature == pytest.approx(0.01 * 0.005, rel=1e-9)  # MuJoCo's cylinder inertia, rounding only
+    # the stated fraction of the wheel's inertia m r^2 / 2 = 0.005 kg m^2
+    assert h.motor_armature == pytest.approx(MOTOR_ARMATURE_FRACTION * 0.005, rel=1e-9)  # cylinder inertia, rounding
     assert out.model.tendon_range[0, 1] == pytest.approx(math.radians(0.5), rel=1e-12)  # in memory: rounding only
 
 

@@ -59,11 +59,18 @@ def _finer(ring: RingGeometry, typical: float, limit: float, flat: bool) -> int 
     return None
 
 
-def ripple_miss(name: str, ring: RingGeometry, sizing: PlaySizing, limit: float, *, flat: bool) -> Miss | None:
-    """The miss of a ring whose force ripple (``sizing.ripple``) reaches the bound ``limit``, or None."""
+def ripple_miss(
+    name: str, ring: RingGeometry, sizing: PlaySizing, limit: float, *, flat: bool, chosen: bool
+) -> Miss | None:
+    """The miss of a ring whose force ripple (``sizing.ripple``) reaches the bound ``limit``, or None.
+
+    Args:
+        name: the hinge. ring: its ring. sizing: its sizing. limit: the ripple bound [-].
+        flat: box segments. chosen: the segment rule chose the count (it then tried every finer one).
+    """
     if not sizing.ripple >= limit:  # NaN (no ring) never misses
         return None
-    finer = _finer(ring, sizing.typical_penetration, limit, flat)
+    finer = None if chosen else _finer(ring, sizing.typical_penetration, limit, flat)
     ring_fix = (
         f"a finer ring, --segments {finer}"
         if finer is not None

@@ -287,11 +287,11 @@ def retrofit(
         )
     options_of = {h.name: _model_options(options, sizings[h.name], step, integrator) for h in hinges}
     rings = {h.name: _ring(joints[h.name], sizings[h.name].segments, options_of[h.name]) for h in hinges if not exact}
-    misses = [
-        miss
-        for name, ring in rings.items()
-        if (miss := ripple_miss(name, ring, sizings[name], options.ripple_limit, flat=flat)) is not None
+    chosen = options.segments is None  # the rule has tried every finer count already
+    found = [
+        ripple_miss(n, ring, sizings[n], options.ripple_limit, flat=flat, chosen=chosen) for n, ring in rings.items()
     ]
+    misses = [m for m in found if m is not None]
     warnings = refuse_or_warn(misses, options.accept_inaccurate)  # before the fits: refusing costs nothing
     done: dict[str, RetrofittedHinge] = {}
     fit_misses: list[Miss] = []

@@ -206,13 +206,14 @@ def simulate_retrofitted(
         k = len(sens)
         q = np.vstack([qpos_before[None], states[: max(k - 1, 0), 1 : 1 + model.nq]])[:k]
         v = np.vstack([qvel_before[None], states[: max(k - 1, 0), 1 + model.nq : 1 + model.nq + model.nv]])[:k]
-        part = reader.read(times[:k], sens[:k], q, v)
-        bad = _first_bad(part, hinges, sens[:k], q)
+        bad = _first_bad(reader.penetrations(sens[:k]), hinges, sens[:k], q)
         if bad is None and failure is not None:
             bad = (k, None, failure)
+        # only the rows kept are read (poses need a kinematics pass each); the bounds saw every row
+        rows = np.arange((-done) % every, k if bad is None else bad[0], every)
+        parts.append(reader.read(times[rows], sens[rows], q[rows], v[rows]))
         if bad is not None:
             idx, joint, why = bad
-            parts.append(part.sliced(slice((-done) % every, idx, every)))
             result = _finish(parts, loaded, twin, drive, t0, done + idx, every, sites)
             tb = float(done + idx) * h
             where = f" at hinge {joint!r}" if joint else ""
@@ -223,7 +224,6 @@ def simulate_retrofitted(
                 time=tb,
                 joint=joint,
             )
-        parts.append(part.sliced(slice((-done) % every, None, every)))
         qpos_before = states[-1, 1 : 1 + model.nq].copy()
         qvel_before = states[-1, 1 + model.nq : 1 + model.nq + model.nv].copy()
         done += n
@@ -245,15 +245,15 @@ def _remedy(loaded: Retrofitted, twin: bool) -> str:
 
 
 def _first_bad(
-    part: SimulationResult, hinges: Sequence[HingeRecord], sens: np.ndarray, q: np.ndarray
+    penetrations: dict[str, np.ndarray], hinges: Sequence[HingeRecord], sens: np.ndarray, q: np.ndarray
 ) -> tuple[int, str | None, str] | None:
     """(row, hinge or None, reason) of a chunk's first row beyond a bound or non-finite, or None."""
-    n = len(part.times)
+    n = len(sens)
     finite = np.isfinite(sens).all(axis=1) & np.isfinite(q).all(axis=1)
     first_nan = int(np.argmin(finite)) if not finite.all() else n
     worst: tuple[int, str, float, float] | None = None
     for hr in hinges:
-        pen = part.joints[hr.name].penetration
+        pen = penetrations[hr.name]
         over = np.nonzero(pen > hr.penetration_limit)[0]
         if len(over) and (worst is None or over[0] < worst[0]):
             worst = (int(over[0]), hr.name, float(pen[over[0]]), hr.penetration_limit)
@@ -313,6 +313,15 @@ class _Reader:
             e for e in range(model.neq) if model.eq_type[e] == mujoco.mjtEq.mjEQ_CONNECT and model.eq_active0[e]
         ]
 
+    def eccentricity(self, sens: np.ndarray, hinge: HingeRecord) -> tuple[np.ndarray, np.ndarray]:
+        """(eccentricity (n, 2) [m], penetration |e| - c (n,) [m]) of a hinge from sensor rows."""
+        e = sens[:, self.ecc[hinge.name]][:, :2].copy()
+        return e, np.hypot(e[:, 0], e[:, 1]) - hinge.radial_clearance
+
+    def penetrations(self, sens: np.ndarray) -> dict[str, np.ndarray]:
+        """Hinge -> its penetration (n,) [m] over sensor rows."""
+        return {hr.name: self.eccentricity(sens, hr)[1] for hr in self.hinges}
+
     def read(self, times: np.ndarray, sens: np.ndarray, q: np.ndarray, v: np.ndarray) -> SimulationResult:
         model, data = self.model, self.data
         n = len(times)
@@ -337,9 +346,8 @@ class _Reader:
                 bearing_rot[name][i] = data.site_xmat[sid].reshape(3, 3)
         joints = {}
         for hr in self.hinges:
-            e = sens[:, self.ecc[hr.name]][:, :2].copy()
+            e, pen = self.eccentricity(sens, hr)
             rate = v[:, self.slide_dof[hr.name]]
-            pen = np.hypot(e[:, 0], e[:, 1]) - hr.radial_clearance
             if hr.name in self.exact:  # the plugin's normal and tangential force, in the bearing frame
                 f = _exact_contact_force(sens, self.exact[hr.name], e)
             else:

@@ -1,0 +1,129 @@
+"""Zero play reproduces the twin: one check that catches a locked joint, a wrong reference angle,
+an open loop or a wrong frame in a retrofit.
+
+A retrofit given (almost) no play must move as the unmodified model does. With a radial
+clearance of `ZERO_CLEARANCE` (1 µm, the exact contact; `ZERO_RING_CLEARANCE`, 10 µm, for a
+ring) at every hinge and loop closure, or a backlash band of `ZERO_BAND` (0.1 arc-minute), a
+point of the model (the end effector) may drift from the twin's by no more than `FACTOR` times
+the geometric play: the sum of the clearances c, or of b times the largest distance from each
+backlashed hinge's axis to the point over the twin's run. A joint locked by a range in the
+wrong units, a band that starts off its centre, a loop that opens or a bearing in the wrong
+frame moves it by orders of magnitude more.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from clearance.results import SimulationResult
+from clearance.retrofit.drive import Drive
+from clearance.run.retrofitted import Retrofitted, simulate_retrofitted, site_output_names
+
+__all__ = [
+    "FACTOR",
+    "ZERO_BAND",
+    "ZERO_CLEARANCE",
+    "ZERO_RING_CLEARANCE",
+    "ZeroPlay",
+    "geometric_play",
+    "zero_play",
+]
+
+ZERO_CLEARANCE = 1e-6
+"""Radial clearance of the zero-play check with the exact contact [m]."""
+
+ZERO_RING_CLEARANCE = 1e-5
+"""Radial clearance of the zero-play check with a ring [m]: 6 written digits of its centimetre offsets
+hold it to 5e-4 of that, and its calibration sees penetrations it can resolve."""
+
+ZERO_BAND = math.radians(0.1 / 60)
+"""Backlash half-width of the zero-play check [rad] (0.1 arc-minute)."""
+
+FACTOR = 10.0
+"""How many times the geometric play the point may drift from the twin's [-]."""
+
+
+@dataclass(frozen=True)
+class ZeroPlay:
+    """The zero-play check of one retrofit.
+
+    Attributes:
+        site: the point watched (a site, or a body's origin).
+        duration: simulated time [s].
+        deviation: largest distance between the point in the retrofitted model and in the twin [m].
+        play: the geometric play at the point (module docstring) [m].
+    """
+
+    site: str
+    duration: float
+    deviation: float
+    play: float
+
+    @property
+    def bound(self) -> float:
+        """`FACTOR` x the geometric play [m]."""
+        return FACTOR * self.play
+
+    @property
+    def holds(self) -> bool:
+        """Whether the point stayed within the bound."""
+        return self.deviation <= self.bound
+
+
+def _points(result: SimulationResult, site: str) -> np.ndarray:
+    """(n, 3) world positions of ``site`` over a run."""
+    return np.column_stack([result.outputs[name] for name in site_output_names(site)])
+
+
+def geometric_play(loaded: Retrofitted, twin_run: SimulationResult, site: str) -> float:
+    """The play at ``site``: the radial clearances, plus each band's b times the largest distance from
+    its hinge's axis to the point over the twin's run (body poses and site positions rows) [m]."""
+    play = sum(h.radial_clearance for h in loaded.manifest.hinges)
+    if not loaded.manifest.backlash:
+        return play
+    twin, point = loaded.twin, _points(twin_run, site)
+    for b in loaded.manifest.backlash:
+        j = twin.joint(b.name).id
+        poses = twin_run.body_poses[:, int(twin.jnt_bodyid[j])]  # the twin's run: its own body order
+        axis = np.zeros((len(poses), 3))
+        anchor = np.zeros((len(poses), 3))
+        mat = np.zeros(9)
+        for i, pose in enumerate(poses):
+            mujoco.mju_quat2Mat(mat, pose[3:])
+            r = mat.reshape(3, 3)
+            anchor[i] = pose[:3] + r @ twin.jnt_pos[j]
+            axis[i] = r @ twin.jnt_axis[j]
+        arm = point - anchor
+        radius = np.linalg.norm(arm - np.sum(arm * axis, axis=1)[:, None] * axis, axis=1)
+        play += b.half_width * float(radius.max())
+    return play
+
+
+def zero_play(
+    loaded: Retrofitted, drive: Drive, duration: float, site: str, *, output_interval: float | None = None
+) -> ZeroPlay:
+    """Run a retrofit given (almost) no play and its twin under ``drive``; how far ``site`` drifts.
+
+    Args:
+        loaded: the retrofit (its plays should be `ZERO_CLEARANCE`, `ZERO_RING_CLEARANCE` or
+            `ZERO_BAND`: the bound is relative to what it has).
+        drive: the controls of both runs.
+        duration: simulated time [s] (0.1 s is the check's).
+        site: a site or body of both models (`clearance.run.retrofitted.point_of`).
+        output_interval: rows kept [s] (the drift is read on them; default every step).
+
+    Raises:
+        SimulationError: a run diverged (the check fails loudly).
+    """
+    runs: Sequence[SimulationResult] = [
+        simulate_retrofitted(loaded, drive, duration, twin=twin, sites=[site], output_interval=output_interval)
+        for twin in (False, True)
+    ]
+    n = min(len(r.times) for r in runs)
+    drift = float(np.max(np.linalg.norm(_points(runs[0], site)[:n] - _points(runs[1], site)[:n], axis=1)))
+    return ZeroPlay(site, duration, drift, geometric_play(loaded, runs[1], site))
