@@ -116,3 +116,26 @@ def test_cli_sizes_from_a_control_file(runs, tmp_path, capsys):
     assert main([*argv[:4], "--out", str(tmp_path / "never"), "--sizing-control", str(ctrl)]) == 2
     assert "unknown actuator 'extra'" in capsys.readouterr().err
     assert not (tmp_path / "never").exists()
+
+
+def test_a_ring_is_refused_exactly_when_its_calibration_misses_the_fit_goals(runs):
+    """Fits that missed their goals passed as notes, exit 0. The same retrofit without accept_inaccurate (its
+    calibration comes from the session's cache) is refused if and only if a fitted speed misses `GOALS`."""
+    from clearance.retrofit.accuracy import InaccurateRetrofitError
+
+    _, _, _, r = runs
+    missed = [row for row in r.hinges["crank_rod"].contact.calibration.rows if not row.meets_goals()]
+    assert bool(r.warnings) == bool(missed)  # kept with a warning: one per missing ring
+    options = dataclasses.replace(r.options, accept_inaccurate=False)
+    plays = {h.name: h.play for h in r.hinges.values()}
+    if not missed:
+        assert not retrofit(r.twin_spec, plays, options).warnings
+        return
+    with pytest.raises(InaccurateRetrofitError) as caught:
+        retrofit(r.twin_spec, plays, options)
+    text = str(caught.value)
+    assert (
+        f"misses the fit's goals at {len(missed)} of" in text
+        and "restitution" in text
+        and "--contact-mode exact" in text
+    )
