@@ -1,14 +1,20 @@
-"""Units in scenario-file key names (``clearance_mm``, ``speed_rpm``, ``length_m``).
+"""Units in scenario-file key names (``clearance_mm``, ``speed_rpm``, ``length_m``), and
+quantities written for people (an SI prefix chosen by size: ``44 N``, ``1.33 kN``, ``6 s``).
 
 Scenario files carry the unit in each key's name; values are converted to SI here, once,
 at the edge. A key without a unit, or with a unit of the wrong kind, is an error.
+
+`scaled_unit` picks the prefix that puts a magnitude between 1 and 1000 (an axis's unit from
+its largest value); `format_quantity` writes one value that way.
 """
 
 from __future__ import annotations
 
 import math
 
-__all__ = ["UNITS", "SI_UNIT", "quantity_of", "describe_units"]
+import numpy as np
+
+__all__ = ["UNITS", "SI_UNIT", "quantity_of", "describe_units", "format_quantity", "scaled_unit"]
 
 UNITS: dict[str, dict[str, float]] = {
     "length": {"m": 1.0, "mm": 1e-3, "cm": 1e-2, "um": 1e-6},
@@ -66,3 +72,60 @@ def quantity_of(param: str) -> str | None:
     if param == "gravity":
         return "acceleration"
     return None
+
+
+_PREFIXES = (("G", 1e9), ("M", 1e6), ("k", 1e3), ("", 1.0), ("m", 1e-3), ("µ", 1e-6), ("n", 1e-9))
+"""SI prefixes, largest first, with their factors."""
+
+_LARGEST_PREFIX = {"s": "", "rad": "", "%": "", "-": "", "rpm": ""}
+"""Units that take no prefix above 1 (no ks, krad); other units go up to G."""
+
+
+def scaled_unit(magnitude: float, unit: str) -> tuple[str, float]:
+    """The prefixed unit in which ``magnitude`` reads between 1 and 1000, and its factor.
+
+    Args:
+        magnitude: the largest value to be shown, in ``unit`` (its sign is ignored).
+        unit: an SI unit (``N``, ``N m``, ``m/s²``, ``s``, ``J``, ...); the prefix goes before
+            it (``kN m``, ``km/s²``, ``ms``). Units without a prefix above 1 (``s``, ``rad``,
+            ``rpm``, ``%``, ``-``) stay as they are from 1 up.
+
+    Returns:
+        (prefixed unit, factor): ``value * factor`` is the value in the prefixed unit. A zero
+        or non-finite magnitude keeps ``unit`` (factor 1).
+    """
+    m = abs(float(magnitude))
+    if not np.isfinite(m) or m == 0.0 or unit in ("%", "-", "rpm"):
+        return unit, 1.0
+    top = _LARGEST_PREFIX.get(unit, "G")
+    allowed = [p for p in _PREFIXES if p[1] <= dict(_PREFIXES)[top]]
+    for prefix, factor in allowed:
+        if m >= factor:
+            return prefix + unit, 1.0 / factor
+    prefix, factor = allowed[-1]
+    return prefix + unit, 1.0 / factor
+
+
+def format_quantity(value: float, unit: str, *, digits: int = 3) -> str:
+    """``value`` written for people: ``digits`` significant digits in the unit chosen by size.
+
+    Args:
+        value: the value in ``unit`` (SI).
+        unit: its unit (see `scaled_unit`).
+        digits: significant digits (trailing zeros dropped).
+
+    Returns:
+        For example ``44 N``, ``1.33 kN``, ``-1.01 kN m``, ``6 s``, ``250 µs``; ``n/a`` for a
+        non-finite value.
+    """
+    v = float(value)
+    if not np.isfinite(v):
+        return "n/a"
+    unit_out, factor = scaled_unit(v, unit)
+    text = f"{v * factor:.{digits}g}"
+    if "e" in text:  # rounding reached 1000 (999.7 N -> 1e+03): one prefix up
+        unit_out, factor = scaled_unit(float(text) / factor, unit)
+        text = f"{v * factor:.{digits}g}"
+    if "e" in text:  # no prefix above (6000 s): the whole number
+        text = f"{v * factor:.0f}"
+    return f"{text} {unit_out}" if unit_out not in ("%", "-") else (f"{text} %" if unit_out == "%" else text)

@@ -208,12 +208,12 @@ def test_report_writes_markdown_and_figures(tmp_path):
         "contact_modes",
         "orbit_rod_slider",
         "phase_0",
-        "poincare_1",
         "bifurcation",
         "criticality",
     ):
         assert (tmp_path / f"{png}.png").exists() and f"({png}.png)" in text
-    # sections: the output's phase portrait and rod_slider's eccentricity, nothing older
+    # 3 periods: no Poincaré section (the output's phase portrait only), nothing older linked
+    assert "No Poincaré section" in text and "poincare_1.png" not in text
     assert "phase_4.png" not in text and "poincare_2.png" not in text
 
 

@@ -1,13 +1,15 @@
-"""A report's figures drawn in two processes: each once, none lost, no process left."""
+"""A report's figures drawn in two processes: each once, none lost, no process left; a child
+started early draws while the report goes on."""
 
 from __future__ import annotations
 
 import os
+import time
 from pathlib import Path
 
 import pytest
 
-from clearance.analysis.figures.drawing import draw, figures_in_parallel
+from clearance.analysis.figures.drawing import draw, figures_in_parallel, start_child
 
 fork_only = pytest.mark.skipif(not hasattr(os, "fork"), reason="drawing in a second process needs os.fork")
 
@@ -87,3 +89,39 @@ def test_a_block_left_by_an_exception_draws_nothing(tmp_path):
     assert not list(tmp_path.iterdir())
     draw(_mark, tmp_path, 1)  # and the queue is gone: outside a block, drawn at once
     assert (tmp_path / "fig1.txt").exists()
+
+
+def _sleep_mark(folder: Path, i: int) -> None:
+    time.sleep(0.05)
+    _mark(folder, i)
+
+
+@fork_only
+def test_a_child_started_early_draws_while_this_process_goes_on(tmp_path, no_child_left):
+    with figures_in_parallel(2):
+        for i in range(6):
+            draw(_sleep_mark, tmp_path, i)
+        start_child()
+        for i in range(6, 9):  # queued after the child started: drawn here at the end
+            draw(_mark, tmp_path, i)
+        deadline = time.monotonic() + 10  # generous: the child is a fork, drawing within ms
+        while not list(tmp_path.iterdir()) and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert list(tmp_path.iterdir())  # the child has drawn while the block was still open
+    pids = [(tmp_path / f"fig{i}.txt").read_text().split() for i in range(9)]
+    assert all(len(p) == 1 for p in pids)  # once each
+    assert {p[0] for p in pids[6:]} == {str(os.getpid())}
+    assert str(os.getpid()) not in {p[0] for p in pids[:1]}  # the first was the child's
+
+
+@fork_only
+def test_a_block_left_by_an_exception_waits_for_a_child_started_early(tmp_path, no_child_left):
+    with pytest.raises(KeyError), figures_in_parallel(2):
+        for i in range(4):
+            draw(_sleep_mark, tmp_path, i)
+        start_child()
+        draw(_mark, tmp_path, 99)
+        raise KeyError("output")
+    assert not (tmp_path / "fig99.txt").exists()  # queued after the start: not drawn
+    drawn = list(tmp_path.iterdir())
+    assert all(p.read_text().count("\n") == 1 for p in drawn)  # what the child drew, once each

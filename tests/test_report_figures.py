@@ -1,6 +1,7 @@
 """What the report and its figures show: the steady state's scale with the start-up marked, one
-contact figure and a distinct contact-mode figure, Poincaré sections with integer periods, the
-clearance circle and a warning when too few, and the report's start-up window.
+contact figure and a distinct contact-mode figure, Poincaré sections with integer periods and the
+clearance circle, no section at all below the minimum of points (the report says why and how many
+revolutions give one), envelopes that keep every peak, and the report's start-up window.
 
 The runs are synthetic (a journal that strikes hard in the first drive period and lightly
 after it), so every number asserted is known by construction.
@@ -17,11 +18,14 @@ from matplotlib.collections import PolyCollection
 
 from clearance.analysis.chaos.poincare import MIN_SECTION_POINTS, section_warning
 from clearance.analysis.figures.analysis_figures import plot_contact_modes, plot_poincare
-from clearance.analysis.figures.canvas import envelope, thin_path
+from clearance.analysis.figures.canvas import thin_path, thin_series
+from clearance.analysis.figures.density import column_envelope, crowding
 from clearance.analysis.figures.plots import plot_contact_force, plot_response
 from clearance.analysis.figures.report import write_report
+from clearance.analysis.figures.report_sections import revolutions_for_sections, section_points
 from clearance.analysis.metrics.response import ContactMode, contact_modes
 from clearance.results import JointResult, SimulationResult
+from clearance.units import format_quantity
 
 T = 0.1  # drive period of the synthetic runs [s]
 W = 2 * np.pi / T
@@ -85,14 +89,18 @@ def _startup_panels(fig):
 def test_response_acceleration_is_scaled_to_the_steady_state_with_the_start_up_beside():
     result, ideal = _runs()
     fig = plot_response(result, ideal, "x", startup=T)
-    lo, hi = _axes(fig, "acceleration").get_ylim()
+    acc = _axes(fig, "acceleration")
+    # the unit chosen by the steady peak (2e3 m/s^2 reads 2 km/s^2)
+    assert acc.get_ylabel() == "acceleration [km/s²]"
+    lo, hi = np.array(acc.get_ylim()) * 1e3
     # the axis holds every steady-state sample (the spike of 2e3 m/s^2 and the ideal's +-987)
     # with its 6 % margin, and stops far below the start-up spike of 5e4 m/s^2
     assert STEADY_ACC <= hi < 0.1 * STARTUP_ACC
     assert lo <= -0.05 * W**2
-    # the start-up at full scale beside it, the spike inside its limits
+    # the start-up at full scale beside it, the spike inside its limits, its axes labelled
     (panel,) = _startup_panels(fig)  # only the acceleration row is clipped
-    assert panel.get_ylim()[1] >= STARTUP_ACC
+    assert panel.get_ylim()[1] * 1e3 >= STARTUP_ACC
+    assert panel.get_ylabel() == "acceleration [km/s²]" and panel.get_xlabel() == "time [ms]"
     # the displacement's steady scale holds its whole range: nothing clipped there
     assert _axes(fig, "displacement").get_ylim()[1] >= 50.0  # 0.05 m in mm
 
@@ -160,9 +168,16 @@ def test_report_names_the_start_up_window_and_keeps_it_apart(tmp_path):
     # contact statistics side by side: start-up peak 40 kN, steady peak 6 kN
     assert "| statistic | j, start-up, 0–100 ms | j, steady state, 100–300 ms |" in text
     assert "| peak force [N] | 4e+04 | 6000 |" in text
-    # the Poincaré warning with its threshold
-    assert "**Too few drive periods for a regime.**" in text and f"fewer than {MIN_SECTION_POINTS}" in text
-    for png in ("response_vs_ideal", "contact_force", "contact_modes", "orbit_j", "deviation", "phase_0", "poincare_1"):
+    # 3 periods, the first the start-up: a point at t = T, 2T (and 3T, where arange's rounding
+    # puts a last sample there); no section drawn; the report says why and that 21 periods
+    # (1 start-up + 20 points) give one
+    ks, _ = section_points(result, ["x"], T, T)
+    assert 2 <= len(ks) < MIN_SECTION_POINTS
+    assert "**No Poincaré section: too few drive periods.**" in text
+    assert f"from {MIN_SECTION_POINTS} points or more; this run gives {len(ks)} (k = 1–{ks[-1]})" in text
+    assert "`clearance run --revolutions 21`" in text and "poincare_1.png" not in text
+    assert not (tmp_path / "poincare_1.png").exists()
+    for png in ("response_vs_ideal", "contact_force", "contact_modes", "orbit_j", "deviation", "phase_0"):
         assert (tmp_path / f"{png}.png").stat().st_size > 10_000
 
 
@@ -171,9 +186,23 @@ def test_a_run_within_its_start_up_window_says_so(tmp_path):
     text = write_report(tmp_path, result, ideal, skip=T).read_text()
     assert "**No steady state**" in text
     assert "not estimated: the run has no whole drive period after its start-up window" in text
-    # every output file is still written (the names a run's folder always has)
-    for png in ("response_vs_ideal", "contact_force", "contact_modes", "orbit_j", "deviation", "phase_0", "poincare_1"):
+    # every figure but the sections is still written; no section point at all
+    for png in ("response_vs_ideal", "contact_force", "contact_modes", "orbit_j", "deviation", "phase_0"):
         assert (tmp_path / f"{png}.png").exists()
+    assert "this run gives no section point" in text
+
+
+def test_a_run_long_enough_gets_its_sections_named_by_number(tmp_path):
+    need = revolutions_for_sections(_runs(1.0)[0], T, T)
+    assert need == MIN_SECTION_POINTS + 1  # the start-up period, then one point per period
+    assert revolutions_for_sections(_runs(1.0)[0], T, 0.0) == MIN_SECTION_POINTS  # t = 0 is a point
+    result, ideal = _runs(periods=float(need))
+    text = write_report(tmp_path, result, ideal, skip=T).read_text()
+    assert "No Poincaré section" not in text
+    # the table names each section's figure: section 0 the output's phase portrait, 1 the joint's
+    assert f"| 0: x / x_vel | phase_0.png | {MIN_SECTION_POINTS} |" in text
+    assert f"| 1: j.ex / j.ey | poincare_1.png | {MIN_SECTION_POINTS} |" in text
+    assert (tmp_path / "poincare_1.png").stat().st_size > 10_000
 
 
 def test_thinning_keeps_every_peak_and_the_ends():
@@ -181,11 +210,46 @@ def test_thinning_keeps_every_peak_and_the_ends():
     y = np.sin(x / 5000)
     y[12_345] = 50.0  # a one-sample spike
     y[77_777] = -40.0
-    tx, ty = envelope(x, y, columns=500)
+    tx, ty = thin_series(x, y, columns=500)
     assert len(tx) <= 2 * 500 + 2 and ty.max() == 50.0 and ty.min() == -40.0
     assert tx[0] == 0 and tx[-1] == x[-1] and np.all(np.diff(tx) > 0)
     keep = thin_path(np.cos(x / 1e4), np.sin(x / 1e4), resolution=1e-3)
     assert keep[0] == 0 and keep[-1] == len(x) - 1 and len(keep) < len(x) / 10
+
+
+@pytest.mark.parametrize("n, columns", [(1_000_003, 640), (4_001, 640), (999, 1500)])
+def test_the_envelope_keeps_every_peak_and_the_column_means(n, columns):
+    rng = np.random.default_rng(7)
+    x = np.cumsum(rng.uniform(0.5, 1.5, n))  # uneven steps: columns of unequal counts
+    y = rng.normal(size=n) + 5 * np.sin(x / x[-1] * 20)
+    k_max, k_min = int(rng.integers(n)), int(rng.integers(n))
+    y[k_max], y[k_min] = 1e3, -1e3  # one-sample peaks anywhere
+    env = column_envelope(x, y, columns=columns)
+    # peaks preserved exactly: the envelope's max is the data's max (the same float, no arithmetic)
+    assert env.high.max() == y.max() == 1e3 and env.low.min() == y.min() == -1e3
+    assert len(env.x) <= columns and env.counts.sum() == n  # every sample in one column
+    # each column: its own samples' min, max and mean (the mean to summation rounding, 1e-12)
+    edges = np.concatenate([[0], np.cumsum(env.counts)])
+    for c in rng.integers(len(env.counts), size=20):
+        part = y[edges[c] : edges[c + 1]]
+        assert env.low[c] == part.min() and env.high[c] == part.max()
+        assert env.mean[c] == pytest.approx(part.mean(), rel=1e-12, abs=1e-12)
+    # a stretch: only its samples, its peaks
+    env = column_envelope(x, y, columns=50, start=x[n // 4], end=x[n // 2])
+    assert env.counts.sum() == n // 2 - n // 4 + 1 and env.high.max() == y[n // 4 : n // 2 + 1].max()
+
+
+def test_a_fast_oscillation_is_crowded_and_drawn_as_a_band_a_slow_one_as_a_line():
+    x = np.linspace(0.0, 6000.0, 600_001)  # ms, as the press's 3 revolutions
+    fast = 30 + 6 * np.sin(2 * np.pi * 0.277 * x)  # 277 Hz: about 5 reversals per pixel column
+    slow = 30 + 6 * np.sin(2 * np.pi * x / 2000)  # the drive's 0.5 Hz
+    pixel = 14.0 / 190  # the axis's range over its height in pixels
+    assert crowding(x, fast, columns=640, pixel=pixel) == 1.0
+    assert crowding(x, slow, columns=640, pixel=pixel) == 0.0
+    result, ideal = _runs()
+    fig = plot_response(result, ideal, "x", startup=T)
+    # the synthetic run's lone spikes are sparse: lines, no band
+    assert not any(c for ax in fig.axes for c in ax.collections if type(c).__name__ == "FillBetweenPolyCollection")
 
 
 def test_report_figures_do_not_import_pyplot(tmp_path):
@@ -201,3 +265,21 @@ def test_report_figures_do_not_import_pyplot(tmp_path):
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 0, proc.stderr
     assert proc.stdout.strip().splitlines()[-1] == "False"
+
+
+@pytest.mark.parametrize(
+    "value, unit, text",
+    [
+        (44.3, "N", "44.3 N"),  # not "0.0443 kN"
+        (1334.0, "N", "1.33 kN"),
+        (-1013.0, "N m", "-1.01 kN m"),
+        (6.0, "s", "6 s"),  # not "6e+03 ms"
+        (2.5e-4, "s", "250 µs"),
+        (999.7, "N", "1 kN"),  # rounding reaches 1000: one prefix up
+        (6000.0, "s", "6000 s"),  # no prefix above the second
+        (1.6e5, "m/s²", "160 km/s²"),
+        (float("nan"), "N", "n/a"),
+    ],
+)
+def test_numbers_are_written_for_people(value, unit, text):
+    assert format_quantity(value, unit) == text

@@ -1,5 +1,5 @@
-"""Figures of the analyses: deviation, contact modes, phase portraits, Poincaré sections,
-bifurcation diagrams and criticality rankings.
+"""Figures of the analyses: contact modes, phase portraits, Poincaré sections, bifurcation
+diagrams and criticality rankings (the deviation's figure is in `deviation_figure`).
 
 Drawn on Agg figures without pyplot (`canvas`); the run figures (response, contact force,
 orbit) are in `clearance.analysis.figures.plots`. Every function returns the figure and,
@@ -21,11 +21,9 @@ from matplotlib.figure import Figure, SubFigure
 from matplotlib.ticker import MaxNLocator
 
 from clearance.analysis.chaos.poincare import PhasePortrait, PoincareClassification, section_warning
-from clearance.analysis.figures.canvas import envelope, new_figure, save_png, thin_path
+from clearance.analysis.figures.canvas import new_figure, save_png, thin_path
 from clearance.analysis.figures.plots import MODE_COLOURS, save_figure
 from clearance.analysis.metrics.response import ContactMode, JointContactModes
-from clearance.analysis.metrics.statistics import DeviationStatistics, deviation_series
-from clearance.results import SimulationResult
 
 if TYPE_CHECKING:  # the sweeps' modules load only where a diagram or ranking is drawn
     from clearance.analysis.sweeps.bifurcation import BifurcationDiagram
@@ -37,7 +35,6 @@ __all__ = [
     "plot_bifurcation",
     "plot_contact_modes",
     "plot_criticality",
-    "plot_deviation",
     "plot_phase_portrait",
     "plot_poincare",
 ]
@@ -79,55 +76,6 @@ def quantity_label(name: str) -> tuple[str, str, float]:
     if name.endswith("_acc"):
         return name, "rad/s²" if angular else "m/s²", 1.0
     return (name, "rad", 1.0) if angular else (name, "mm", 1e3)
-
-
-def plot_deviation(
-    result: SimulationResult,
-    ideal: SimulationResult,
-    output: str,
-    stats: DeviationStatistics,
-    *,
-    path: str | Path | None = None,
-) -> Figure:
-    """Deviation from ideal over the statistics window, its 90 % band, and distributions.
-
-    Args:
-        result: run with clearance.
-        ideal: run of the ideal twin.
-        output: output name.
-        stats: its `DeviationStatistics` (the window is taken from them).
-        path: PNG path to save to.
-    """
-    t, y, y0 = deviation_series(result, ideal, output, skip=stats.window_start - result.times[0])
-    label, unit, scale = quantity_label(output)
-    fig = new_figure(11, 4)
-    gs = fig.add_gridspec(1, 2, width_ratios=[2, 1], left=0.08, right=0.98, top=0.86, bottom=0.14, wspace=0.22)
-    a1, a2 = fig.add_subplot(gs[0, 0]), fig.add_subplot(gs[0, 1])
-    a1.plot(*envelope(t * 1e3, (y - y0) * scale), lw=0.7, color="C3", label="deviation y - y_ideal")
-    for v, lab in ((stats.band90, "90 % band ±"), (-stats.band90, None)):
-        a1.axhline(v * scale, color="k", ls="--", lw=0.9, label=lab and f"{lab}{stats.band90 * scale:.3g} {unit}")
-    a1.axhline(stats.mean_signed_deviation * scale, color="C2", lw=1.0, label="mean (signed)")
-    a1.set_xlabel("time [ms]")
-    a1.set_ylabel(f"{label} deviation [{unit}]")
-    a1.legend(loc="upper right", fontsize=8)
-    a1.locator_params(axis="y", nbins=6)
-    a1.grid(alpha=0.3)
-    bins = np.linspace(min(y.min(), y0.min()), max(y.max(), y0.max()), 40) * scale
-    for values, colour, name in ((y0, "0.5", "ideal"), (y, "C3", "with clearance")):
-        counts, _ = np.histogram(values * scale, bins=bins)
-        a2.stairs(counts, bins, fill=True, alpha=0.5, color=colour, label=name)  # one artist, not 40 bars
-    a2.set_xlabel(f"{label} [{unit}]")
-    a2.set_ylabel("samples")
-    a2.legend(fontsize=8)
-    a2.set_title(f"KS = {stats.ks_statistic:.3g}, F = {stats.f_statistic:.4g}", fontsize=9)
-    fig.suptitle(
-        f"{output}: mean deviation {stats.mean_deviation * scale:.3g} {unit}, "
-        f"RMS {stats.rms_deviation * scale:.3g} {unit} (window from t = {stats.window_start * 1e3:.3g} ms)",
-        fontsize=11,
-    )
-    if path is not None:
-        save_png(fig, path)
-    return fig
 
 
 def plot_contact_modes(
@@ -225,7 +173,11 @@ def _warn(ax: Axes, text: str) -> None:
 
 
 def plot_phase_portrait(
-    portrait: PhasePortrait, *, section: np.ndarray | None = None, path: str | Path | None = None
+    portrait: PhasePortrait,
+    *,
+    section: np.ndarray | None = None,
+    label: str | None = None,
+    path: str | Path | None = None,
 ) -> Figure:
     """Phase portrait (quantity against its rate), with Poincaré points on top if given.
 
@@ -235,9 +187,10 @@ def plot_phase_portrait(
     Args:
         portrait: `PhasePortrait` data.
         section: (K, 2) Poincaré points (quantity, rate) to mark.
+        label: text put before the title (e.g. the report's section number).
         path: PNG path to save to.
     """
-    label, unit, scale = quantity_label(portrait.name)
+    qlab, unit, scale = quantity_label(portrait.name)
     vlab, vunit, vscale = quantity_label(
         f"{portrait.name}_vel" if "." not in portrait.name else portrait.name.replace(".e", ".v")
     )
@@ -254,9 +207,9 @@ def plot_phase_portrait(
         warning = section_warning(len(section))
         if warning:
             _warn(ax, warning)
-    ax.set_xlabel(f"{label} [{unit}]")
+    ax.set_xlabel(f"{qlab} [{unit}]")
     ax.set_ylabel(f"{vlab} [{vunit}]")
-    ax.set_title(f"phase portrait of {portrait.name}", fontsize=11)
+    ax.set_title(f"{label}: " * bool(label) + f"phase portrait of {portrait.name}", fontsize=11)
     ax.legend(loc="upper right", fontsize=8)
     ax.grid(alpha=0.3)
     if path is not None:

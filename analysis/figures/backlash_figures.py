@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
-from clearance.analysis.figures.canvas import envelope, new_figure, save_png
+from clearance.analysis.figures.canvas import draw_series, new_figure, save_png
 from clearance.analysis.metrics.backlash_impacts import BacklashSummary
 from clearance.results import SimulationResult
 
@@ -41,14 +41,14 @@ def plot_backlash(result: SimulationResult, summary: BacklashSummary, *, path: s
     a1 = fig.add_subplot(gs[0, 0])
     a2 = fig.add_subplot(gs[1, 0], sharex=a1)
     b = summary.half_width / ARCMIN
-    a1.plot(*envelope(t, angle), lw=0.8, color="C0", label="q_load - q_motor")
+    draw_series(a1, t, angle, style={"lw": 0.8, "color": "C0", "label": "q_load - q_motor"}, reach=(-b, b))
     for v, lab in ((b, f"band ends ±{b:.3g}'"), (-b, None)):
         a1.axhline(v, color="k", ls="--", lw=0.9, label=lab)
     a1.set_ylabel("backlash angle [arcmin]")
     a1.legend(loc="upper right", fontsize=8)
     a1.grid(alpha=0.3)
     a1.tick_params(labelbottom=False)
-    a2.plot(*envelope(t, torque), lw=0.8, color="C3", label="stop torque")
+    draw_series(a2, t, torque, style={"lw": 0.8, "color": "C3", "label": "stop torque"})
     engaged = torque > 0
     onsets = np.flatnonzero(np.concatenate([engaged[:1], engaged[1:] & ~engaged[:-1]]))
     if len(onsets):

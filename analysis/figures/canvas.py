@@ -5,12 +5,14 @@ Every figure of a run is a `matplotlib.figure.Figure` on an Agg canvas (`new_fig
 pyplot import, no figure manager, nothing to close. `save_png` draws it once (a fixed layout,
 no tight bounding box, which would draw it twice) and writes the PNG atomically.
 
-Time series with far more samples than the axis has pixel columns are thinned by `envelope`
-(the smallest and largest sample of each column, in time order, so every peak stays); paths
-drawn in a plane (orbits, phase portraits) by `thin_path` (a point every fraction of the
-figure's size along the path). Axes scaled to the steady state get the start-up window
-shaded (`mark_startup`) and the start-up samples beyond their limits marked at the edge
-(`mark_clipped`).
+Time series with far more samples than the axis has pixel columns are drawn by `draw_series`:
+a crowded one as the min-max band of each pixel column with the column means as its line
+(`density`), any other as its min-max line (`thin_series`: the smallest and largest sample of
+each column, in time order); every peak stays. Paths drawn in a plane (orbits, phase
+portraits) are thinned by `thin_path` (a point every fraction of the figure's size along the
+path). Axes scaled to the steady state (`steady_scale`) get the start-up window shaded
+(`mark_startup`) and the start-up samples beyond their limits marked at the edge
+(`mark_clipped`); `time_rows` lays such axes out.
 """
 
 from __future__ import annotations
@@ -27,23 +29,24 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.transforms import blended_transform_factory
 
+from clearance.analysis.figures.density import CROWDED_SHARE, column_envelope, crowding
 from clearance.results import atomic_write_bytes
 
 __all__ = [
+    "BAND_ALPHA",
     "DPI",
     "STARTUP_COLOUR",
     "Clipped",
     "Trace",
-    "draw_startup_panel",
-    "draw_steady_scaled",
-    "envelope",
+    "axes_pixels",
+    "draw_series",
     "mark_clipped",
     "mark_startup",
     "new_figure",
     "save_png",
-    "steady_limits",
+    "steady_scale",
     "thin_path",
-    "traces_clipped",
+    "thin_series",
 ]
 
 DPI = 100
@@ -51,6 +54,13 @@ DPI = 100
 
 STARTUP_COLOUR = "0.88"
 """Fill of the start-up window on time axes (light grey)."""
+
+BAND_ALPHA = 0.25
+"""Opacity of an envelope band (`draw_series`): the lines beneath show through."""
+
+_MARKER_PX = 20
+"""Pixels per edge marker of `mark_clipped` at most: a marker is 7 px wide, and a row of them closer
+than a few widths reads as a bar."""
 
 _ENVELOPE_COLUMNS = 1500
 """Columns of `envelope`: above the pixel width of every time axis drawn at `DPI`."""
@@ -92,8 +102,8 @@ def save_png(fig: Figure, path: str | Path, *, dpi: int = DPI) -> Path:
     return Path(path)
 
 
-def envelope(x: np.ndarray, y: np.ndarray, *, columns: int = _ENVELOPE_COLUMNS) -> tuple[np.ndarray, np.ndarray]:
-    """Min/max thinning of a time series for drawing.
+def thin_series(x: np.ndarray, y: np.ndarray, *, columns: int = _ENVELOPE_COLUMNS) -> tuple[np.ndarray, np.ndarray]:
+    """Min/max thinning of a time series for drawing as a line.
 
     The samples are cut into ``columns`` runs of equal count; each run keeps its smallest and
     largest sample, in time order, plus the first and last sample of the series. Drawn as a
@@ -175,35 +185,11 @@ class Clipped:
     peak_time: float
 
 
-def steady_limits(
-    x: np.ndarray, series: list[np.ndarray], steady_from: float, *, pad: float = 0.06
-) -> tuple[float, float] | None:
-    """y-limits that hold every sample of ``series`` from ``steady_from`` on, padded.
-
-    Args:
-        x: (n,) abscissa shared by the series.
-        series: (n,) arrays.
-        steady_from: start of the steady state on ``x``.
-        pad: margin on each side as a fraction of the range.
-
-    Returns:
-        (low, high), or None when no sample lies in the steady state (the caller keeps
-        matplotlib's automatic limits).
-    """
-    sel = x >= steady_from
-    if not sel.any():
-        return None
-    vals = np.concatenate([np.asarray(s)[sel] for s in series])
-    vals = vals[np.isfinite(vals)]
-    if len(vals) == 0:
-        return None
-    lo, hi = float(vals.min()), float(vals.max())
-    margin = pad * (hi - lo) if hi > lo else max(abs(hi), 1.0) * pad
-    return lo - margin, hi + margin
-
-
 def mark_clipped(ax: Axes, x: np.ndarray, y: np.ndarray, limits: tuple[float, float], *, colour: str) -> Clipped | None:
     """Mark where a series leaves the axis's limits: a triangle at the edge per excursion.
+
+    Excursions closer than a marker's width are marked once (a dense run of them would
+    otherwise draw a solid bar along the edge).
 
     Args:
         ax: the axes (its y-limits are ``limits``).
@@ -224,11 +210,12 @@ def mark_clipped(ax: Axes, x: np.ndarray, y: np.ndarray, limits: tuple[float, fl
     tips_arr = np.asarray(tips)
     up = y[tips_arr] > hi
     tr = blended_transform_factory(ax.transData, ax.transAxes)
+    x0, x1 = ax.get_xlim()
+    slot = np.floor((x[tips_arr] - x0) / ((x1 - x0) or 1.0) * axes_pixels(ax)[0] / _MARKER_PX).astype(int)
     for sel, yy, marker in ((up, 0.985, "^"), (~up, 0.015, "v")):
         if sel.any():
-            ax.plot(
-                x[tips_arr[sel]], np.full(int(sel.sum()), yy), marker, color=colour, ms=5, transform=tr, clip_on=False
-            )
+            shown = tips_arr[sel][np.unique(slot[sel], return_index=True)[1]]
+            ax.plot(x[shown], np.full(len(shown), yy), marker, color=colour, ms=5, transform=tr, clip_on=False)
     beyond = np.maximum(y[tips_arr] - hi, lo - y[tips_arr])
     worst = tips_arr[int(np.argmax(beyond))]
     return Clipped(len(tips), float(y[worst]), float(x[worst]))
@@ -251,93 +238,80 @@ class Trace:
     marks_clipping: bool = True
 
 
-def _limits_of(traces: list[Trace], steady_from: float, include_zero: bool) -> tuple[float, float] | None:
-    lims = [steady_limits(tr.x, [tr.y], steady_from, pad=0.0) for tr in traces]
-    got = [lim for lim in lims if lim is not None]
-    if not got:
+def steady_scale(traces: list[Trace], steady_from: float, *, include_zero: bool = False) -> tuple[float, float] | None:
+    """y-limits holding every sample of ``traces`` from ``steady_from`` on, with a 6 % margin.
+
+    Args:
+        traces: the traces of one axes (x increasing).
+        steady_from: start of the steady state on their abscissa (their first time: the whole run).
+        include_zero: the limits reach down (or up) to 0 (a magnitude).
+
+    Returns:
+        (low, high), or None when no trace has a finite sample from ``steady_from`` on.
+    """
+    lo, hi = np.inf, -np.inf
+    for tr in traces:
+        part = tr.y[int(np.searchsorted(tr.x, steady_from, side="left")) :]  # a view: nothing copied
+        if len(part):  # fmin/fmax skip NaN without a warning
+            lo, hi = min(lo, float(np.fmin.reduce(part))), max(hi, float(np.fmax.reduce(part)))
+    if not (np.isfinite(lo) and np.isfinite(hi)):
         return None
-    lo, hi = min(lim[0] for lim in got), max(lim[1] for lim in got)
     if include_zero:
         lo, hi = min(lo, 0.0), max(hi, 0.0)
     margin = 0.06 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.06
     return lo - margin, hi + margin
 
 
-def traces_clipped(traces: list[Trace], steady_from: float, *, include_zero: bool = False) -> bool:
-    """Whether a clipping-marked trace leaves the steady-state limits of ``traces`` (`draw_steady_scaled`).
-
-    Args:
-        traces: the traces of one axes.
-        steady_from: start of the steady state on their abscissa.
-        include_zero: the limits reach down (or up) to 0 (a magnitude).
-    """
-    lim = _limits_of(traces, steady_from, include_zero)
-    if lim is None:
-        return False
-    return any(tr.marks_clipping and bool(np.any((tr.y < lim[0]) | (tr.y > lim[1]))) for tr in traces)
+def axes_pixels(ax: Axes) -> tuple[int, int]:
+    """(width, height) of an axes in pixels of the saved PNG (from its position; nothing drawn)."""
+    fig = ax.get_figure(root=True)
+    pos = ax.get_position()
+    w, h = (fig.get_size_inches() if fig is not None else (6.4, 4.8)) * DPI
+    return max(1, int(pos.width * w)), max(1, int(pos.height * h))
 
 
-def draw_steady_scaled(
+def draw_series(
     ax: Axes,
-    traces: list[Trace],
-    startup: tuple[float, float],
+    x: np.ndarray,
+    y: np.ndarray,
     *,
-    label: str | None = "start-up",
-    include_zero: bool = False,
-) -> tuple[tuple[float, float] | None, list[Clipped]]:
-    """Draw traces (thinned by `envelope`) with y-limits from the steady state and the start-up marked.
+    style: dict[str, Any],
+    pixel: float | None = None,
+    reach: tuple[float, ...] = (),
+) -> bool:
+    """Draw a time series at the axes' resolution; a crowded one as its envelope band and mean line.
 
-    The limits hold every sample after the start-up window of every trace; the window is
-    shaded (`mark_startup`) and start-up samples beyond the limits are marked at the edge
-    (`mark_clipped`). With no sample after the window the limits are matplotlib's.
+    Up to two samples per pixel column the series is drawn as it is. Beyond, a series that a
+    line would paint solid (`density.crowding` at or above `density.CROWDED_SHARE`) is drawn as
+    the min-max band of each pixel column (translucent, beneath the other lines) with the
+    column means as its line; any other as its min-max line (`thin_series`), which covers the
+    same pixels as the full series. Every peak stays either way.
 
     Args:
-        ax: axes with time on x.
-        traces: the series, drawn in order.
-        startup: (start, end) of the start-up window on x.
-        label: text of the window (None: none).
-        include_zero: the limits reach down (or up) to 0 (a magnitude).
+        ax: the axes (placed: its pixel width sets the columns).
+        x, y: (n,) the series in display units.
+        style: ``Axes.plot`` keywords (``color``, ``lw``, ``label``, ``zorder``).
+        pixel: one pixel of the axes in y's unit (its y-range over its height in pixels);
+            default from the range of ``y`` and ``reach``.
+        reach: other values the axes will show (lines drawn beside the series).
 
     Returns:
-        The limits set (None: automatic) and the excursions beyond them, one per marked trace
-        that leaves them.
+        Whether the band was drawn.
     """
-    for tr in traces:
-        ax.plot(*envelope(tr.x, tr.y), **tr.style)
-    ax.locator_params(axis="y", nbins=5)  # fewer ticks: each costs a few ms to draw
-    mark_startup(ax, *startup, label=label)
-    lim = _limits_of(traces, startup[1], include_zero)
-    clipped: list[Clipped] = []
-    if lim is not None:
-        ax.set_ylim(*lim)
-        for tr in traces:
-            if tr.marks_clipping:
-                c = mark_clipped(ax, tr.x, tr.y, lim, colour=str(tr.style.get("color", "k")))
-                if c is not None:
-                    clipped.append(c)
-    return lim, clipped
-
-
-def draw_startup_panel(
-    ax: Axes, traces: list[Trace], startup: tuple[float, float], limits: tuple[float, float]
-) -> None:
-    """The start-up window at full scale, with the steady-state limits as dashed lines.
-
-    Args:
-        ax: the (small) axes beside the steady-scaled one.
-        traces: the same traces.
-        startup: (start, end) of the start-up window on x.
-        limits: the steady-state limits of the main axes.
-    """
-    for tr in traces:
-        sel = (tr.x >= startup[0]) & (tr.x <= startup[1])
-        style = {k: v for k, v in tr.style.items() if k != "label"}
-        ax.plot(*envelope(tr.x[sel], tr.y[sel], columns=400), **style)
-    for v in limits:
-        ax.axhline(v, color="0.3", lw=0.8, ls="--")
-    ax.set_xlim(*startup)
-    ax.locator_params(nbins=4)
-    ax.set_facecolor("0.96")
-    ax.tick_params(labelsize=7)
-    ax.set_title("start-up, full scale\n(dashes: steady-state scale)", fontsize=8)
-    ax.grid(alpha=0.3)
+    columns, rows = axes_pixels(ax)
+    if pixel is None:
+        lo = min([float(np.min(y)), *reach]) if len(y) else 0.0
+        hi = max([float(np.max(y)), *reach]) if len(y) else 1.0
+        pixel = ((hi - lo) or 1.0) / rows
+    if len(x) <= 2 * columns:
+        ax.plot(x, y, **style)
+        return False
+    if crowding(x, y, columns=columns, pixel=pixel) < CROWDED_SHARE:
+        ax.plot(*thin_series(x, y, columns=columns), **style)
+        return False
+    env = column_envelope(x, y, columns=columns)
+    colour = style.get("color", "k")
+    z = float(style.get("zorder", 2.0))
+    ax.fill_between(env.x, env.low, env.high, color=colour, alpha=BAND_ALPHA, lw=0, zorder=z - 0.3)
+    ax.plot(env.x, env.mean, **style)
+    return True

@@ -11,8 +11,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from clearance.analysis.figures.analysis_figures import plot_deviation
 from clearance.analysis.figures.backlash_figures import backlash_section
+from clearance.analysis.figures.deviation_figure import plot_deviation
 from clearance.analysis.figures.plots import plot_contact_force, plot_orbit
 from clearance.analysis.metrics.backlash_impacts import backlash_summaries
 from clearance.analysis.metrics.response import contact_modes

@@ -16,26 +16,27 @@ from pathlib import Path
 
 import numpy as np
 from matplotlib import colormaps
-from matplotlib.axes import Axes
 from matplotlib.cm import ScalarMappable
 from matplotlib.colors import BoundaryNorm
 from matplotlib.figure import Figure
 from matplotlib.patches import Patch
-from matplotlib.ticker import FormatStrFormatter
+from matplotlib.ticker import FormatStrFormatter, MaxNLocator
 
-from clearance.analysis.figures.canvas import (
-    Trace,
-    draw_startup_panel,
-    draw_steady_scaled,
-    new_figure,
-    save_png,
-    thin_path,
-    traces_clipped,
-)
+from clearance.analysis.figures.canvas import Trace, new_figure, save_png, thin_path
+from clearance.analysis.figures.time_rows import Layout, Row, band_legend_entry, draw_time_rows
 from clearance.analysis.metrics.response import ContactMode, JointContactModes, contact_modes
 from clearance.results import SimulationResult, atomic_write_bytes
+from clearance.units import scaled_unit
 
-__all__ = ["MODE_COLOURS", "force_unit", "plot_response", "plot_contact_force", "plot_orbit", "save_figure"]
+__all__ = [
+    "MODE_COLOURS",
+    "plot_response",
+    "plot_contact_force",
+    "plot_orbit",
+    "on_times",
+    "save_figure",
+    "steady_peak",
+]
 
 MODE_COLOURS = {ContactMode.FREE_FLIGHT: "0.93", ContactMode.IMPACT: "C3", ContactMode.CONTINUOUS: "C0"}
 """Colour of each contact mode in the contact figures."""
@@ -69,45 +70,35 @@ def _window(result: SimulationResult, startup: float) -> tuple[float, float]:
     return t0, t0 + startup * 1e3
 
 
-def _steady_rows(
-    fig: Figure,
-    rows: Sequence[list[Trace]],
-    window: tuple[float, float],
-    *,
-    left: float,
-    top: float,
-    bottom: float,
-    include_zero: bool = False,
-) -> list[tuple[Axes, list[Trace]]]:
-    """Axes for rows of traces sharing time: a start-up panel beside each row that needs one.
+def on_times(times: np.ndarray, other_times: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """``values`` sampled at ``other_times``, read at ``times`` (linear); as they are where the times agree.
 
-    Returns (main axes, traces) per row, drawn; the panels are drawn too.
+    Args:
+        times: (n,) where to read [s].
+        other_times: (m,) increasing, where ``values`` were sampled [s].
+        values: (m,) the series.
     """
-    clipped = [traces_clipped(tr, window[1], include_zero=include_zero) for tr in rows]
-    panel = any(clipped)
-    gs = fig.add_gridspec(
-        len(rows),
-        2 if panel else 1,
-        width_ratios=[4.3, 1] if panel else None,
-        left=left,
-        right=0.98,
-        top=top,
-        bottom=bottom,
-        hspace=0.32,
-        wspace=0.26,
-    )
-    out = []
-    first = None
-    for i, traces in enumerate(rows):
-        ax = fig.add_subplot(gs[i, 0], sharex=first)
-        first = first or ax
-        lim, _ = draw_steady_scaled(ax, traces, window, label="start-up" if i == 0 else None, include_zero=include_zero)
-        if clipped[i] and lim is not None:
-            draw_startup_panel(fig.add_subplot(gs[i, 1]), traces, window, lim)
-        if i < len(rows) - 1:
-            ax.tick_params(labelbottom=False)
-        out.append((ax, traces))
-    return out
+    if len(times) == len(other_times) and np.array_equal(times, other_times):
+        return values
+    return np.interp(times, other_times, values)
+
+
+def scaled(values: np.ndarray, scale: float) -> np.ndarray:
+    """``values * scale``; ``values`` themselves for a scale of 1 (no copy of a long series)."""
+    return values if scale == 1.0 else values * scale
+
+
+def steady_peak(times: np.ndarray, y: np.ndarray, startup: float) -> float:
+    """Largest |y| after the start-up window (the whole run's without one or without samples after it).
+
+    Args:
+        times: (n,) [s].
+        y: (n,) the series.
+        startup: the start-up window from the run's start [s] (0: none).
+    """
+    k0 = int(np.searchsorted(times, times[0] + startup)) if startup > 0 else 0
+    part = y[k0:] if k0 < len(y) else y
+    return float(np.max(np.abs(part))) if len(part) else 0.0
 
 
 def plot_response(
@@ -121,16 +112,21 @@ def plot_response(
 ) -> Figure:
     """Output displacement, velocity and acceleration against the ideal mechanism.
 
-    Each panel is scaled to the steady state (after ``startup``); the start-up window is
+    Each row is scaled to the steady state (after ``startup``); the start-up window is
     shaded, its samples beyond that scale are marked by triangles at the edge and shown at
-    full scale in a small panel beside.
+    full scale in a small panel beside. A crowded series is drawn as its envelope band with
+    the mean line, the ideal on top; where a row cannot be read over the whole run (crowded,
+    or more than `time_rows.ZOOM_AFTER_CYCLES` drive cycles) a zoom into the steady state
+    comes beside it (`time_rows.draw_time_rows`). Velocity and acceleration units are chosen
+    by size (``km/s²`` for 1.6e5 m/s²).
 
     Args:
         result: run with clearance.
         ideal: run of the ideal twin (or None).
         output: output name (e.g. ``slider_x``).
         angular: the output is an angle (units rad, rad/s, rad/s²).
-        startup: start-up window from the run's start [s] (0: none).
+        startup: start-up window from the run's start [s] (0: none); also the drive period
+            that a zoom shows.
         path: PNG path to save to.
 
     Returns:
@@ -140,41 +136,53 @@ def plot_response(
         KeyError: unknown output.
     """
     labels = [
-        ("displacement", output, "rad" if angular else "mm", 1.0 if angular else 1e3),
-        ("velocity", output + "_vel", "rad/s" if angular else "m/s", 1.0),
-        ("acceleration", output + "_acc", "rad/s²" if angular else "m/s²", 1.0),
+        ("displacement", output, "rad" if angular else "m"),
+        ("velocity", output + "_vel", "rad/s" if angular else "m/s"),
+        ("acceleration", output + "_acc", "rad/s²" if angular else "m/s²"),
     ]
     t_ms = result.times * 1e3
     rows = []
-    for _, key, _, scale in labels:
+    for title, key, si in labels:
+        y = result.outputs[key]
+        if angular:
+            unit, scale = si, 1.0
+        elif key == output:
+            unit, scale = "mm", 1e3  # positions of a mechanism: mm throughout
+        else:
+            unit, scale = scaled_unit(steady_peak(result.times, y, startup), si)
         traces = []
         if ideal is not None:
-            y0 = np.interp(result.times, ideal.times, ideal.outputs[key]) * scale
-            traces.append(Trace(t_ms, y0, {"color": "0.55", "lw": 1.6, "label": "ideal"}, marks_clipping=False))
-        traces.append(Trace(t_ms, result.outputs[key] * scale, {"color": "C3", "lw": 0.8, "label": "with clearance"}))
-        rows.append(traces)
-    fig = new_figure(9.5, 8.0)
-    drawn = _steady_rows(fig, rows, _window(result, startup), left=0.1, top=0.91, bottom=0.07)
-    for (ax, _), (title, _, unit, _) in zip(drawn, labels):
-        ax.set_label(title)
-        ax.set_ylabel(f"{title} [{unit}]")
-        ax.grid(alpha=0.3)
-    drawn[0][0].legend(loc="upper right", fontsize=8)
-    drawn[-1][0].set_xlabel("time [ms]")
+            y0 = scaled(on_times(result.times, ideal.times, ideal.outputs[key]), scale)
+            traces.append(
+                Trace(t_ms, y0, {"color": "0.5", "lw": 1.8, "label": "ideal", "zorder": 2.0}, marks_clipping=False)
+            )
+        traces.append(
+            Trace(t_ms, scaled(y, scale), {"color": "C3", "lw": 0.8, "label": "with clearance", "zorder": 2.2})
+        )
+        rows.append(Row(traces, title, f"{title} [{unit}]", si, scale))
+    fig, drawn, _ = draw_time_rows(
+        rows, window=_window(result, startup), cycle=startup * 1e3, layout=Layout(row_height=2.0, top=0.75)
+    )
+    handles, names = drawn[0].main.get_legend_handles_labels()
+    if any(d.band for d in drawn):
+        handles.append(band_legend_entry("C3"))
+        names.append(handles[-1].get_label())
+    drawn[0].main.legend(handles, names, loc="upper right", fontsize=7)
     cl = ", ".join(result.joints) or "none"
     scale_note = ""
     if startup > 0:
         steady = result.times[-1] > result.times[0] + startup
         scale_note = "; y-scale of the steady state" if steady else "; the whole run is its start-up window"
-    fig.suptitle(f"{result.metadata.get('mechanism', '')}: {output} (clearance at {cl}){scale_note}", fontsize=11)
+    fig.text(
+        0.02,
+        1 - 0.3 / fig.get_figheight(),
+        f"{result.metadata.get('mechanism', '')}: {output} (clearance at {cl}){scale_note}",
+        fontsize=11,
+        va="center",
+    )
     if path is not None:
         save_png(fig, path)
     return fig
-
-
-def force_unit(peak: float) -> tuple[str, float]:
-    """(unit, scale from N) for a force axis whose largest value is ``peak`` [N]: kN from 1 kN on."""
-    return ("kN", 1e-3) if peak >= 1e3 else ("N", 1.0)
 
 
 def plot_contact_force(
@@ -186,14 +194,19 @@ def plot_contact_force(
 ) -> Figure:
     """Contact force of each clearance joint against time, its contact modes shaded beneath.
 
-    One panel per joint, scaled to the steady state (after ``startup``): the background is
+    One row per joint, scaled to the steady state (after ``startup``): the background is
     coloured by contact mode (impact, continuous contact; free flight unshaded), the start-up
     window is shaded grey, start-up peaks beyond the scale are marked at the edge and shown
-    at full scale beside. The force unit is kN when the steady peak is 1 kN or more.
+    at full scale beside (named above the row when the joints fill two columns). A crowded
+    force is drawn as its envelope band with the mean line; a zoom into the steady state comes
+    beside where the whole run cannot be read (`time_rows.draw_time_rows`). The force unit is
+    chosen by the steady peak (N, kN, MN). More than 4 joints get lower rows, more than 8 two
+    columns of rows.
 
     Args:
         result: the run.
-        startup: start-up window from the run's start [s] (0: none).
+        startup: start-up window from the run's start [s] (0: none); also the drive period
+            that a zoom shows.
         modes: the joints' `JointContactModes` (events over the whole run); default
             computed with `contact_modes`.
         path: PNG path to save to.
@@ -206,38 +219,43 @@ def plot_contact_force(
     t_ms = result.times * 1e3
     window = _window(result, startup)
     rows = []
-    units = []
     for j in joints:
         f = result.joints[j].force_magnitude
-        steady = f[t_ms >= window[1]]
-        unit, scale = force_unit(float(steady.max()) if len(steady) and startup > 0 else float(f.max(initial=0.0)))
-        units.append(unit)
-        rows.append([Trace(t_ms, f * scale, {"color": "k", "lw": 0.6, "label": "contact force"})])
-    fig = new_figure(9.5, 1.3 + 2.6 * max(1, len(joints)))
+        unit, scale = scaled_unit(steady_peak(result.times, f, startup), "N")
+        rows.append(
+            Row(
+                [Trace(t_ms, scaled(f, scale), {"color": "0.15", "lw": 0.6})],
+                j,
+                f"{j} force [{unit}]",
+                "N",
+                scale,
+                True,
+            )
+        )
+    many = len(joints) > 4
+    layout = Layout(row_height=1.45 if many else 2.0, top=1.0, groups=2 if len(joints) > 8 else 1)
+    fig, drawn, _ = draw_time_rows(rows, window=window, cycle=startup * 1e3, layout=layout)
+    for d in drawn:
+        m = by_joint[d.row.label]
+        for ax in (d.main, d.zoom):
+            if ax is None:
+                continue
+            for mode in (ContactMode.IMPACT, ContactMode.CONTINUOUS):
+                spans = [(e.start * 1e3, e.duration * 1e3) for e in m.events if e.mode is mode]
+                if spans:
+                    ax.broken_barh(
+                        spans, (0, 1), transform=ax.get_xaxis_transform(), color=MODE_COLOURS[mode], alpha=0.22, lw=0
+                    )
     h = fig.get_figheight()
-    drawn = _steady_rows(fig, rows, window, left=0.09, top=1 - 1.0 / h, bottom=0.55 / h, include_zero=True)
-    for (ax, _), j, unit in zip(drawn, joints, units):
-        ax.set_label(j)
-        m = by_joint[j]
-        for mode in (ContactMode.IMPACT, ContactMode.CONTINUOUS):
-            spans = [(e.start * 1e3, e.duration * 1e3) for e in m.events if e.mode is mode]
-            if spans:
-                ax.broken_barh(
-                    spans, (0, 1), transform=ax.get_xaxis_transform(), color=MODE_COLOURS[mode], alpha=0.22, lw=0
-                )
-        ax.set_ylabel(f"{j} force [{unit}]")
-        ax.grid(alpha=0.3)
-    if drawn:
-        drawn[-1][0].set_xlabel("time [ms]")
     handles = [Patch(facecolor="white", edgecolor="0.6", label="free flight")]
     handles += [Patch(color=MODE_COLOURS[m], alpha=0.4, label=m.value.replace("_", " ")) for m in list(ContactMode)[1:]]
     if startup > 0:  # a run without a start-up window (a retrofitted model) has no span to name
         handles.append(Patch(color="0.85", label="start-up window"))
-    fig.legend(
-        handles=handles, loc="upper left", ncol=4, fontsize=8, frameon=False, bbox_to_anchor=(0.08, 1 - 0.42 / h)
-    )
+    if any(d.band for d in drawn):
+        handles.append(band_legend_entry("0.15"))
+    fig.legend(handles=handles, loc="upper left", ncol=3, fontsize=8, frameon=False, bbox_to_anchor=(0.01, 1 - 0.4 / h))
     title = f"{result.metadata.get('mechanism', '')}: contact force at the clearance joints, by contact mode"
-    fig.text(0.09, 1 - 0.25 / h, title, fontsize=11, va="center")
+    fig.text(0.02, 1 - 0.22 / h, title, fontsize=11, va="center")
     if path is not None:
         save_png(fig, path)
     return fig
@@ -273,7 +291,10 @@ def plot_orbit(
     ax = fig.add_axes((0.13, 0.1, 0.66, 0.8))
     cax = fig.add_axes((0.83, 0.18, 0.03, 0.64))
     th = np.linspace(0, 2 * np.pi, 400)
-    ax.plot(c * np.cos(th), c * np.sin(th), color="k", lw=1.2, label=f"clearance circle (c = {c:g} µm)")
+    # the circle on top: a long run's orbit runs along it and would hide it
+    ax.plot(
+        c * np.cos(th), c * np.sin(th), color="k", lw=1.0, ls="--", zorder=4, label=f"clearance circle (c = {c:g} µm)"
+    )
     if len(early):
         ax.plot(e[early, 0], e[early, 1], color="0.6", lw=0.5, label="start-up")
     edges = np.linspace(split, float(t_ms[-1]), 13)
@@ -288,7 +309,8 @@ def plot_orbit(
             ax.plot(e[idx, 0], e[idx, 1], color=cmap(k), lw=0.9, label=label)
     ax.plot(e[0, 0], e[0, 1], "o", color="C3", ms=5, label="start")
     bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), cax=cax, label="time [ms]")
-    bar.set_ticks(edges[::3].tolist())
+    ticks = MaxNLocator(nbins=6).tick_values(edges[0], edges[-1])
+    bar.set_ticks([v for v in ticks if edges[0] <= v <= edges[-1]])
     bar.ax.yaxis.set_major_formatter(FormatStrFormatter("%.4g"))
     ax.set_aspect("equal")
     lim = 1.15 * max(c, float(np.abs(e).max()) if len(e) else c)

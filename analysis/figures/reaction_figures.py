@@ -1,31 +1,33 @@
 """Joint reactions in a report: the figure of every joint's load over time and the report's section.
 
 `plot_reactions` draws, per joint, the magnitude of its reaction force (the force its link_a
-exerts on its link_b) and, per drive, the magnitude of its torque, for the run and its ideal
+exerts on its link_b) and, per drive, its torque with its sign, for the run and its ideal
 twin, on the steady-state scale with the start-up window shaded, its excursions beyond that
-scale marked at the edge and the largest one written in the panel (one axes per series, no
-side panels: axes dominate a figure's drawing time). `reaction_section` writes the report's
+scale marked at the edge and the largest one named above the row (no start-up panels: axes
+dominate a figure's drawing time), and a zoom into the steady state beside where the whole run
+cannot be read. `reaction_section` writes the report's
 Markdown section: whole-run and steady-state peaks side by side, the per-cycle spread and the
 load factor against the ideal twin (`clearance.analysis.metrics.reactions`).
 """
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
 
-from clearance.analysis.figures.canvas import Trace, draw_steady_scaled, envelope, new_figure, save_png
-from clearance.analysis.figures.plots import force_unit
+from clearance.analysis.figures.canvas import Trace, save_png
+from clearance.analysis.figures.plots import on_times, scaled, steady_peak
+from clearance.analysis.figures.time_rows import Layout, Row, band_legend_entry, draw_time_rows
 from clearance.analysis.metrics.reactions import ReactionSummary, reaction_magnitudes, summarise_reactions
 from clearance.results import SimulationResult
+from clearance.units import format_quantity, scaled_unit
 
 __all__ = ["plot_reactions", "reaction_section"]
 
-_MAX_ROWS = 6
-"""Panels per column: more joints than this go into two columns."""
+_ONE_COLUMN = 10
+"""Rows in one column at most: more joints and drives than this go into two columns."""
 
 
 def plot_reactions(
@@ -35,109 +37,95 @@ def plot_reactions(
     startup: float = 0.0,
     path: str | Path | None = None,
 ) -> Figure:
-    """Reaction magnitude of every joint and drive against time, the ideal twin beside.
+    """Reaction magnitude of every joint and the signed torque of every drive against time, the ideal twin beside.
 
     Args:
         result: a run with joint reactions.
         ideal: its ideal twin's run (drawn in grey), or None.
-        startup: start-up window from the run's start [s] (0: none; the scale is the whole run's).
-            The largest start-up excursion beyond the steady-state scale is written in its panel.
+        startup: start-up window from the run's start [s] (0: none; the scale is the whole run's);
+            also the drive period that a zoom shows. The largest start-up excursion beyond the
+            steady-state scale is named above its row.
         path: PNG path to save to.
 
     Returns:
-        The figure: one axes per joint and drive, labelled with its name.
+        The figure: one row per joint and drive, its axes labelled with the name; a zoom into
+        the steady state beside each where the whole run cannot be read
+        (`time_rows.draw_time_rows`). Units are chosen by each row's steady peak.
 
     Raises:
         ValueError: the result has no joint reactions (a result saved before they existed).
     """
     if not result.joint_reactions:
         raise ValueError("the result has no joint reactions (saved before they existed): rerun it")
-    mags = reaction_magnitudes(result)
-    ideal_mags = reaction_magnitudes(ideal) if ideal is not None else {}
-    names = list(mags)
+    series = _signed(result)
+    ideal_series = _signed(ideal) if ideal is not None else {}
     t_ms = result.times * 1e3
-    t0 = float(t_ms[0]) if len(t_ms) else 0.0
-    window = (t0, t0 + startup * 1e3)
-    rows, units = [], []
-    for name in names:
+    rows = []
+    for name, y in series.items():
         drive = name not in result.joint_reactions
-        steady = mags[name][t_ms >= window[1]] if startup > 0 else mags[name]
-        peak = float(np.nanmax(steady, initial=0.0)) if len(steady) else 0.0
-        unit, scale = ("N m", 1.0) if drive else force_unit(peak)
-        units.append(unit)
+        si = "N m" if drive else "N"
+        unit, scale = scaled_unit(steady_peak(result.times, y, startup), si)
         traces = []
-        if ideal is not None and name in ideal_mags:
-            y0 = np.interp(result.times, ideal.times, ideal_mags[name]) * scale
-            traces.append(Trace(t_ms, y0, {"color": "0.55", "lw": 1.6, "label": "ideal twin"}, marks_clipping=False))
-        colour = "C0" if drive else "C3"
-        traces.append(Trace(t_ms, mags[name] * scale, {"color": colour, "lw": 0.7, "label": "run"}))
-        rows.append(traces)
-    ncols = 1 if len(names) <= _MAX_ROWS else 2
-    nrows = math.ceil(len(names) / ncols)
-    fig = new_figure(9.0 if ncols == 1 else 14.0, 1.0 + 1.55 * nrows)
+        if name in ideal_series and ideal is not None:
+            y0 = scaled(on_times(result.times, ideal.times, ideal_series[name]), scale)
+            style = {"color": "0.5", "lw": 1.8, "label": "ideal twin", "zorder": 2.0}
+            traces.append(Trace(t_ms, y0, style, marks_clipping=False))
+        run = {"color": "C0" if drive else "C3", "lw": 0.7, "label": "run", "zorder": 2.2}
+        traces.append(Trace(t_ms, scaled(y, scale), run))
+        what = "torque" if drive else "|F|"
+        rows.append(Row(traces, name, f"{name} {what} [{unit}]", si, scale, include_zero=not drive))
+    groups = 1 if len(rows) <= _ONE_COLUMN else 2
+    layout = Layout(
+        row_height=1.5 if len(rows) <= 6 else 1.25,
+        main_width=6.4 if groups == 1 else 5.0,
+        top=0.85,
+        groups=groups,
+        startup_panels=False,
+    )
+    t0 = float(t_ms[0]) if len(t_ms) else 0.0
+    fig, drawn, _ = draw_time_rows(rows, window=(t0, t0 + startup * 1e3), cycle=startup * 1e3, layout=layout)
+    handles, names = drawn[0].main.get_legend_handles_labels()
+    if any(d.band for d in drawn):
+        handles.append(band_legend_entry())
+        names.append(handles[-1].get_label())
+    drawn[0].main.legend(handles, names, loc="upper right", fontsize=7)
     h = fig.get_figheight()
-    gs = fig.add_gridspec(
-        nrows,
-        ncols,
-        left=0.09 if ncols == 1 else 0.06,
-        right=0.98,
-        top=1 - 0.7 / h,
-        bottom=0.5 / h,
-        hspace=0.38,
-        wspace=0.22,
-    )
-    first = None
-    for i, (name, traces, unit) in enumerate(zip(names, rows, units)):
-        r, c = i % nrows, i // nrows
-        ax = fig.add_subplot(gs[r, c], sharex=first)
-        first = first or ax
-        if startup > 0:
-            lim, clipped = draw_steady_scaled(ax, traces, window, label="start-up" if r == 0 else None)
-            if clipped:
-                worst = max(clipped, key=lambda k: abs(k.peak))
-                value = f"{worst.peak:.0f}" if abs(worst.peak) >= 1e3 else f"{worst.peak:.3g}"
-                ax.set_title(
-                    f"start-up peak {value} {unit} at {worst.peak_time:.3g} ms (off this scale)",
-                    loc="left",
-                    fontsize=7,
-                    pad=2,
-                    color="0.3",
-                )
-        else:
-            for tr in traces:
-                ax.plot(*envelope(tr.x, tr.y), **tr.style)
-        ax.set_label(name)
-        kind = "torque" if name not in result.joint_reactions else "|F|"
-        ax.set_ylabel(f"{name} {kind} [{unit}]", fontsize=8)
-        ax.tick_params(labelsize=8)
-        ax.grid(alpha=0.3)
-        if r == nrows - 1 or i == len(names) - 1:
-            ax.set_xlabel("time [ms]", fontsize=9)
-        else:
-            ax.tick_params(labelbottom=False)
-        if i == 0:
-            ax.legend(loc="upper right", fontsize=7)
     scale_note = "; y-scale of the steady state" if startup > 0 else ""
-    title = (
-        f"{result.metadata.get('mechanism', '')}: joint reactions (force of each joint's first link on its second) "
-        f"and drive torques{scale_note}"
+    fig.text(
+        0.02,
+        1 - 0.22 / h,
+        f"{result.metadata.get('mechanism', '')}: joint reactions and drive torques{scale_note}",
+        fontsize=10,
+        va="center",
     )
-    fig.text(0.5, 1 - 0.35 / h, title, fontsize=10, ha="center", va="center")
+    fig.text(
+        0.02,
+        1 - 0.45 / h,
+        "joints: |F|, the magnitude of the force of the joint's first link on its second; drives: the torque, signed",
+        fontsize=8,
+        va="center",
+        color="0.3",
+    )
     if path is not None:
         save_png(fig, path)
     return fig
 
 
+def _signed(result: SimulationResult) -> dict[str, np.ndarray]:
+    """`reaction_magnitudes` with each drive's torque signed, as the drive applies it [N m]."""
+    out = reaction_magnitudes(result)
+    drives = [name for name in out if name not in result.joint_reactions]
+    for k, name in enumerate(drives):
+        out[name] = result.drive_torque[:, k]
+    return out
+
+
 def _fmt(value: float, unit: str) -> str:
-    if not np.isfinite(value):
-        return "–"
-    if unit == "N" and abs(value) >= 1e3:
-        return f"{value / 1e3:.3g} kN"
-    return f"{value:.4g} {unit}"
+    return "–" if not np.isfinite(value) else format_quantity(value, unit)
 
 
 def _ms(t: float) -> str:
-    return "–" if not np.isfinite(t) else f"{t * 1e3:.3g} ms"
+    return "–" if not np.isfinite(t) else format_quantity(t, "s")
 
 
 def reaction_section(

@@ -20,12 +20,20 @@ import numpy as np
 
 from clearance.analysis.figures import analysis_figures as figures
 from clearance.analysis.figures import plots
-from clearance.analysis.figures.drawing import draw, figures_in_parallel
-from clearance.analysis.figures.report_sections import Window, contact_section, poincare_section, section_points
+from clearance.analysis.figures.deviation_figure import plot_deviation
+from clearance.analysis.figures.drawing import draw, figures_in_parallel, start_child
+from clearance.analysis.figures.report_sections import (
+    Window,
+    clearance_of,
+    contact_section,
+    poincare_section,
+    section_points,
+)
 from clearance.analysis.metrics.lag import OutputLag, joint_lag
 from clearance.analysis.metrics.response import window_peaks
 from clearance.analysis.metrics.statistics import deviation_statistics, drive_period
 from clearance.results import ENERGY_TERMS, SimulationResult, atomic_write_text
+from clearance.units import format_quantity
 
 if TYPE_CHECKING:  # types only: the sweeps' modules load only where a diagram or ranking is drawn
     from clearance.analysis.metrics.reactions import ReactionSummary
@@ -72,7 +80,7 @@ def startup_lines(window: Window) -> list[str]:
             "",
         ]
     lines = [
-        f"**Start-up window**: {window.ms(window.start, window.split)}, the first period of the slowest "
+        f"**Start-up window**: {window.span(window.start, window.split)}, the first period of the slowest "
         "prescribed drive. The journal is released from the bearing centre and makes its first, largest "
         "impacts in it. Start-up values are taken within it; steady-state values (peaks and peak ratios, "
         "lag, deviation statistics, contact statistics, Poincaré sections) after it.",
@@ -80,7 +88,7 @@ def startup_lines(window: Window) -> list[str]:
     ]
     if not window.has_steady_state:
         lines += [
-            f"**No steady state**: the run ({window.ms(window.start, window.end)}) is no longer than its "
+            f"**No steady state**: the run ({window.span(window.start, window.end)}) is no longer than its "
             "start-up window; the values below are of the start-up alone. Run at least two drive periods "
             "for steady-state numbers.",
             "",
@@ -146,10 +154,10 @@ def reactions_section(
     out: Path,
     rows: list[ReactionSummary] | None = None,
 ) -> list[str]:
-    """The report's "Joint reactions" section (the bearing load at every joint) and its figure.
+    """The report's "Joint reactions" section (the bearing load at every joint).
 
-    Draws ``joint_reactions.png`` (`plot_reactions`) and returns the section of
-    `reaction_section`, both with the report's start-up window.
+    The section of `reaction_section` with the report's start-up window, linking
+    ``joint_reactions.png`` (`plot_reactions`, which `write_report` draws).
 
     Args:
         result: a run with joint reaction series (``SimulationResult.joint_reactions``).
@@ -161,12 +169,11 @@ def reactions_section(
     Returns:
         The section's Markdown lines.
     """
-    from clearance.analysis.figures.reaction_figures import plot_reactions, reaction_section
+    from clearance.analysis.figures.reaction_figures import reaction_section
     from clearance.analysis.metrics.reactions import summarise_reactions
 
     if rows is None:
         rows = summarise_reactions(result, ideal, startup=window.startup)
-    draw(plot_reactions, result, ideal, startup=window.startup, path=out / "joint_reactions.png")
     return reaction_section(result, ideal, startup=window.startup, figure="joint_reactions.png", rows=rows)
 
 
@@ -218,7 +225,7 @@ def _deviation_lines(
         st = deviation_statistics(result, ideal, output, skip=skip)
     except ValueError as err:  # fewer than 3 samples in the window
         return lines + [f"No deviation statistics: {err}.", ""]
-    draw(figures.plot_deviation, result, ideal, output, st, path=out / "deviation.png")
+    draw(plot_deviation, result, ideal, output, st, path=out / "deviation.png")
     lines += ["| statistic | value |", "|---|---:|"]
     lines += [f"| {k} | {_g(v) if isinstance(v, float) else v} |" for k, v in st.as_dict().items()]
     what = (
@@ -289,6 +296,29 @@ def write_report(
     return path
 
 
+def _time_figures(
+    out: Path, result: SimulationResult, ideal: SimulationResult, output: str, window: Window, reactions: bool
+) -> None:
+    """Queue the figures that need none of the report's numbers: response, contact force, orbits, reactions."""
+    draw(
+        plots.plot_response,
+        result,
+        ideal,
+        output,
+        angular="angle" in output,
+        startup=window.startup,
+        path=out / "response_vs_ideal.png",
+    )
+    if result.joints:
+        draw(plots.plot_contact_force, result, startup=window.startup, path=out / "contact_force.png")
+    for j in result.joints:
+        draw(plots.plot_orbit, result, j, clearance_of(result, j), startup=window.startup, path=out / f"orbit_{j}.png")
+    if reactions:
+        from clearance.analysis.figures.reaction_figures import plot_reactions
+
+        draw(plot_reactions, result, ideal, startup=window.startup, path=out / "joint_reactions.png")
+
+
 def _report_lines(
     out: Path,
     result: SimulationResult,
@@ -318,25 +348,23 @@ def _report_lines(
         "mujoco_version",
     ):
         if key in md and md[key] not in (None, "", {}, []):  # e.g. no ring segments in the exact mode
-            lines.append(f"| {key} | {md[key]} |")
+            value = md[key]
+            if key in ("time_step", "wall_time_s") and isinstance(value, (int, float)):
+                value = format_quantity(float(value), "s")  # 3 µs, 12.3 s: not 3e-06 nor 17 digits
+            lines.append(f"| {key} | {value} |")
     lines.append(
-        f"| simulated time | {result.times[-1] * 1e3:.4g} ms ({result.times[-1] / period:.3g} drive periods) |"
+        f"| simulated time | {format_quantity(float(result.times[-1]), 's', digits=4)} "
+        f"({result.times[-1] / period:.3g} drive periods) |"
     )
-    lines.append(f"| start-up window | {window.ms(window.start, window.split)} |")
+    lines.append(f"| start-up window | {window.span(window.start, window.split)} |")
     lines.append("")
     lines += startup_lines(window)
+    has_reactions = bool(getattr(result, "joint_reactions", None))
+    _time_figures(out, result, ideal, output, window, has_reactions)
+    sections = poincare_section(result, output, window, period, out)  # a few points: cheap
+    start_child()  # the figures so far are drawn while the numbers below are computed
 
     lines += ["## Response against the ideal mechanism", ""]
-    angular = "angle" in output
-    draw(
-        plots.plot_response,
-        result,
-        ideal,
-        output,
-        angular=angular,
-        startup=window.startup,
-        path=out / "response_vs_ideal.png",
-    )
     lines += ["![response](response_vs_ideal.png)", ""]
     keys = [k for k in (output, f"{output}_vel", f"{output}_acc") if k in result.outputs]
     lines += _response_table(result, ideal, keys, window)
@@ -352,10 +380,10 @@ def _report_lines(
     lines += _deviation_lines(result, ideal, output, window, out)
     if result.joints:
         lines += contact_section(result, window, out)
-    if getattr(result, "joint_reactions", None):  # the joint reactions' section, where the result has them
+    if has_reactions:  # the joint reactions' section, where the result has them
         lines += reactions_section(result, ideal, window, out, reactions)
     lines += energy_section(result)
-    lines += poincare_section(result, output, window, period, out)
+    lines += sections
 
     if bifurcation is not None:
         draw(figures.plot_bifurcation, bifurcation, path=out / "bifurcation.png")

@@ -7,6 +7,7 @@ Used by `clearance.analysis.figures.report`.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -18,16 +19,23 @@ from clearance.analysis.chaos.poincare import (
     phase_portrait,
     poincare_from_result,
     quantity_series,
-    section_warning,
 )
 from clearance.analysis.figures import analysis_figures as figures
-from clearance.analysis.figures import plots
 from clearance.analysis.figures.drawing import draw
-from clearance.analysis.metrics.response import ContactMode, JointContactModes, contact_modes
+from clearance.analysis.metrics.response import CONTINUOUS_SHARE, ContactMode, JointContactModes, contact_modes
+from clearance.analysis.metrics.statistics import drive_period
 from clearance.analysis.metrics.summary import JointSummary, joint_summary
 from clearance.results import SimulationResult
+from clearance.units import format_quantity, scaled_unit
 
-__all__ = ["Window", "clearance_of", "contact_section", "poincare_section", "section_points"]
+__all__ = [
+    "Window",
+    "clearance_of",
+    "contact_section",
+    "poincare_section",
+    "revolutions_for_sections",
+    "section_points",
+]
 
 
 @dataclass(frozen=True)
@@ -54,9 +62,10 @@ class Window:
         """Whether samples follow the start-up window (the steady-state numbers exist)."""
         return self.end > self.split
 
-    def ms(self, a: float, b: float) -> str:
-        """'a–b ms' of two times [s]."""
-        return f"{a * 1e3:.4g}–{b * 1e3:.4g} ms"
+    def span(self, a: float, b: float) -> str:
+        """'a–b <unit>' of two times [s], the unit chosen by the larger ('0–12 ms', '2–6 s')."""
+        unit, factor = scaled_unit(max(abs(a), abs(b)), "s")
+        return f"{a * factor:.4g}–{b * factor:.4g} {unit}"
 
 
 def clearance_of(result: SimulationResult, joint: str) -> float:
@@ -126,12 +135,13 @@ _STATISTICS = (
 )
 
 
-def _summary(result: SimulationResult, joint: str, sel: np.ndarray, steady: bool, startup: float) -> JointSummary:
+def _summary(result: SimulationResult, joint: str, sel: slice, steady: bool, startup: float) -> JointSummary:
     """A window's `JointSummary` of one joint; the steady state's as summary.csv counts it.
 
     The steady-state impacts, contact fraction and forces are `joint_summary`'s ``steady_*``
     values (an onset needs the sample before it, so a contact running on from the start-up is
-    no new impact); the other windows are summarised on their own samples.
+    no new impact); the other windows are summarised on their own samples (``sel``: their rows,
+    a slice, so the result's arrays are viewed, not copied).
     """
     part = joint_summary(result.sliced(sel), joint)
     if not steady:
@@ -147,8 +157,21 @@ def _summary(result: SimulationResult, joint: str, sel: np.ndarray, steady: bool
     )
 
 
+_WIDE_TABLE = 4
+"""Joint-window columns of the contact table at most; more (three joints and up) turn it to one row each."""
+
+
+def _contact_table(names: list[tuple[str, str]], columns: list[list[str]]) -> list[str]:
+    """The contact statistics: a column per joint and window, or a row each when there are many."""
+    if len(columns) <= _WIDE_TABLE:
+        lines = ["| statistic |" + "".join(f" {j}, {w} |" for j, w in names), "|---|" + "---:|" * len(names)]
+        return lines + [f"| {name} | " + " | ".join(c[i] for c in columns) + " |" for i, name in enumerate(_STATISTICS)]
+    lines = ["| joint | window | " + " | ".join(_STATISTICS) + " |", "|---|---|" + "---:|" * len(_STATISTICS)]
+    return lines + [f"| {j} | {w} | " + " | ".join(c) + " |" for (j, w), c in zip(names, columns)]
+
+
 def contact_section(result: SimulationResult, window: Window, out: Path) -> list[str]:
-    """The "Contact at the clearance joints" section; draws contact_force.png, contact_modes.png, orbits.
+    """The "Contact at the clearance joints" section; draws contact_modes.png, links contact_force.png and orbits.
 
     Args:
         result: the run (with clearance joints).
@@ -159,20 +182,20 @@ def contact_section(result: SimulationResult, window: Window, out: Path) -> list
         The section's Markdown lines: start-up and steady-state statistics side by side.
     """
     joints = list(result.joints)
-    t = result.times
-    whole = [contact_modes(result, j) for j in joints]
+    k = int(np.searchsorted(result.times, window.split))  # the first steady-state row
+    parts: list[tuple[str, slice, dict[str, float]]]
     if window.startup > 0:
-        parts = [(f"start-up, {window.ms(window.start, window.split)}", t < window.split, {"end": window.startup})]
+        parts = [(f"start-up, {window.span(window.start, window.split)}", slice(0, k), {"end": window.startup})]
         steady = (
-            f"steady state, {window.ms(window.split, window.end)}"
+            f"steady state, {window.span(window.split, window.end)}"
             if window.has_steady_state
             else "steady state: none (the run ends in the start-up window)"
         )
-        parts.append((steady, t >= window.split, {"skip": window.startup}))
+        parts.append((steady, slice(k, len(result.times)), {"skip": window.startup}))
     else:
-        parts = [(f"whole run, {window.ms(window.start, window.end)}", np.ones(len(t), bool), {})]
-    draw(plots.plot_contact_force, result, startup=window.startup, modes=whole, path=out / "contact_force.png")
-    by_part = {label: [contact_modes(result, j, **kw) for j in joints] for label, sel, kw in parts if sel.any()}
+        parts = [(f"whole run, {window.span(window.start, window.end)}", slice(0, len(result.times)), {})]
+    rows_in = {label: sel.stop - sel.start for label, sel, _ in parts}
+    by_part = {label: [contact_modes(result, j, **kw) for j in joints] for label, _, kw in parts if rows_in[label]}
     draw(
         figures.plot_contact_modes,
         by_part,
@@ -180,12 +203,11 @@ def contact_section(result: SimulationResult, window: Window, out: Path) -> list
         + ", ".join(label.split(",")[0].split(":")[0] for label in by_part),
         path=out / "contact_modes.png",
     )
-    head, rule, columns = ["| statistic |"], ["|---|"], []
+    names, columns = [], []
     for i, j in enumerate(joints):
         for label, sel, kw in parts:
-            head.append(f" {j}, {label} |")
-            rule.append("---:|")
-            if label in by_part and np.count_nonzero(sel) >= 2:
+            names.append((j, label))
+            if label in by_part and rows_in[label] >= 2:
                 columns.append(_column(_summary(result, j, sel, "skip" in kw, window.startup), by_part[label][i]))
             else:
                 columns.append(["n/a"] * len(_STATISTICS))
@@ -197,12 +219,12 @@ def contact_section(result: SimulationResult, window: Window, out: Path) -> list
             "from the steady state.",
             "",
         ]
-    lines += ["".join(head), "".join(rule)]
-    lines += [f"| {name} | " + " | ".join(c[i] for c in columns) + " |" for i, name in enumerate(_STATISTICS)]
-    thr = whole[0].continuous_after * 1e3 if whole else float("nan")
+    lines += _contact_table(names, columns)
+    thr = CONTINUOUS_SHARE * drive_period(result)
     lines += [
         "",
-        f"A contact event (penetration > 0 without a break) lasting at least {thr:.3g} ms (5 % of the drive "
+        f"A contact event (penetration > 0 without a break) lasting at least {format_quantity(thr, 's')} (5 % of "
+        "the drive "
         "period) is continuous contact, a shorter one an impact; an event is classified over its whole "
         "duration and counted in the window it starts in. Shares are of the window's time.",
         "",
@@ -212,17 +234,39 @@ def contact_section(result: SimulationResult, window: Window, out: Path) -> list
         "",
     ]
     for j in joints:
-        draw(plots.plot_orbit, result, j, clearance_of(result, j), startup=window.startup, path=out / f"orbit_{j}.png")
         lines += [f"![orbit {j}](orbit_{j}.png)", ""]
     return lines
 
 
-def poincare_section(result: SimulationResult, output: str, window: Window, period: float, out: Path) -> list[str]:
-    """The "Phase portraits and Poincaré sections" section; draws phase_<k>.png and poincare_<k>.png.
+def revolutions_for_sections(result: SimulationResult, period: float, skip: float) -> int:
+    """Drive periods a run needs for `chaos.poincare.MIN_SECTION_POINTS` section points.
 
-    Sections sample t = kT of the drive after the start-up window; a section with fewer than
-    `chaos.poincare.MIN_SECTION_POINTS` points is flagged in the table, under it and on its
-    figure.
+    Section points lie at t = kT from the end of the start-up window on, up to the run's last
+    sample (one step before its end): the first at k0 = ceil(skip / T), so k0 + MIN - 1 < the
+    run's length in periods.
+
+    Args:
+        result: the run (its start).
+        period: drive period T [s].
+        skip: the start-up window [s].
+
+    Returns:
+        The smallest whole number of drive periods that gives the minimum.
+    """
+    k0 = max(0, math.ceil(skip / period - 1e-6)) if period > 0 else 0
+    return k0 + MIN_SECTION_POINTS
+
+
+def poincare_section(result: SimulationResult, output: str, window: Window, period: float, out: Path) -> list[str]:
+    """The "Phase portraits and Poincaré sections" section; draws phase_0.png and poincare_<k>.png.
+
+    Sections sample t = kT of the drive after the start-up window, the same instants for every
+    quantity. Below `chaos.poincare.MIN_SECTION_POINTS` points no section is drawn or
+    classified: the section says how many points the run gives and how many drive periods
+    would give the minimum (`revolutions_for_sections`), and only the output's phase portrait
+    is drawn. Figures are numbered by section: section 0 is the output's phase portrait
+    (``phase_0.png``), section k >= 1 the k-th clearance joint's eccentricity
+    (``poincare_<k>.png``); the table and each figure's title name both.
 
     Args:
         result: the run.
@@ -236,36 +280,43 @@ def poincare_section(result: SimulationResult, output: str, window: Window, peri
     """
     sections = [(output, f"{output}_vel")] + [(f"{j}.ex", f"{j}.ey") for j in result.joints]
     lines = ["## Phase portraits and Poincaré sections", ""]
-    lines += ["| section | points | regime | period | divergence | correlation dim. |", "|---|---:|---|---:|---:|---:|"]
+    ks, _ = section_points(result, [output], period, window.startup)
+    if len(ks) < MIN_SECTION_POINTS:
+        need = revolutions_for_sections(result, period, window.startup)
+        have = "no section point" if not len(ks) else f"{len(ks)} (k = {ks[0]}–{ks[-1]})"
+        draw(figures.plot_phase_portrait, phase_portrait(result, output), label="section 0", path=out / "phase_0.png")
+        return lines + [
+            f"**No Poincaré section: too few drive periods.** A section samples the motion once per drive period "
+            f"after the start-up window (t = kT), and a regime (periodic, quasi-periodic, chaotic) is told from "
+            f"{MIN_SECTION_POINTS} points or more; this run gives {have}. A run of {need} drive periods "
+            f"({format_quantity(need * period, 's')}: `clearance run --revolutions {need}`) gives "
+            f"{MIN_SECTION_POINTS}. The journal's path is in its orbit figure above; the output's phase portrait "
+            "(section 0) follows.",
+            "",
+            "![section 0: phase portrait](phase_0.png)",
+            "",
+        ]
+    lines += [
+        "| section | figure | points | regime | period | divergence | correlation dim. |",
+        "|---|---|---:|---|---:|---:|---:|",
+    ]
     # figures written by this call only: an earlier report in the same folder may have left others
     pngs: list[tuple[int, str]] = []
-    warnings: list[str] = []
     # the trajectory drawn behind a section: the steady state's, or the whole run's when it has none
     after = result.times >= (window.split if window.has_steady_state else window.start)
     for k, names in enumerate(sections):
         ks, pts = section_points(result, list(names), period, window.startup)
         vals = np.column_stack([quantity_series(result, n)[after] for n in names])
-        cl = None
-        if len(pts):
-            scale = float(np.sqrt(np.mean(np.sum((vals - vals.mean(axis=0)) ** 2, axis=1))))
-            cl = classify_poincare(pts, scale=scale)
-        flag = " (too few)" if len(pts) < MIN_SECTION_POINTS else ""
+        scale = float(np.sqrt(np.mean(np.sum((vals - vals.mean(axis=0)) ** 2, axis=1))))
+        cl = classify_poincare(pts, scale=scale)
+        name = f"phase_{k}.png" if k == 0 else f"poincare_{k}.png"
         lines.append(
-            f"| {names[0]} / {names[1]} | {len(pts)}{flag} | "
-            + (
-                f"{cl.regime.value} | {cl.period} | {cl.divergence:.3g} | {cl.correlation_dimension:.3g} |"
-                if cl is not None
-                else "n/a | | | |"
-            )
+            f"| {k}: {names[0]} / {names[1]} | {name} | {len(pts)} | {cl.regime.value} | {cl.period} | "
+            f"{cl.divergence:.3g} | {cl.correlation_dimension:.3g} |"
         )
-        warning = section_warning(len(pts))
-        if warning:
-            warnings.append(f"{names[0]} / {names[1]}: {warning}")
-        if names[1].endswith("_vel"):
-            draw(
-                figures.plot_phase_portrait, phase_portrait(result, names[0]), section=pts, path=out / f"phase_{k}.png"
-            )
-            pngs.append((k, f"phase_{k}.png"))
+        if k == 0:
+            portrait = phase_portrait(result, names[0])
+            draw(figures.plot_phase_portrait, portrait, section=pts, label="section 0", path=out / name)
         else:
             joint = names[0].rpartition(".")[0]
             draw(
@@ -276,23 +327,16 @@ def poincare_section(result: SimulationResult, output: str, window: Window, peri
                 trajectory=vals,
                 periods=ks,
                 clearance=clearance_of(result, joint),
-                path=out / f"poincare_{k}.png",
+                label=f"section {k}: {joint}",
+                path=out / name,
             )
-            pngs.append((k, f"poincare_{k}.png"))
-    lines.append("")
-    if warnings:
-        lines += [
-            f"**Too few drive periods for a regime.** A regime is told from {MIN_SECTION_POINTS} section points "
-            "or more (one per drive period after the start-up window); below that the regime column says "
-            "little:",
-            "",
-        ]
-        lines += [f"- {w}" for w in warnings]
-        lines.append("")
+        pngs.append((k, name))
     lines += [
+        "",
         "Regime criterion: `clearance.analysis.chaos.poincare` (distinct points within 1 % of the motion's RMS "
         "size, then nearest-neighbour divergence of the section map). Points are coloured by their drive period "
-        "k (t = kT); the eccentricity sections show the clearance circle.",
+        "k (t = kT); the eccentricity sections show the clearance circle. Section 0 is the output's phase "
+        "portrait (phase_0.png), section k the k-th clearance joint's eccentricity (poincare_k.png).",
         "",
     ]
     lines += [f"![section {k}]({name})" for k, name in pngs]

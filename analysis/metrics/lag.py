@@ -35,6 +35,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import numpy as np
+from scipy.fft import next_fast_len
 
 from clearance.analysis.metrics.statistics import drive_period
 from clearance.results import SimulationResult
@@ -98,7 +99,9 @@ def _misfits(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """
     n, nb = len(a), len(b)
     a = a - a.mean()
-    size = 1 << int(np.ceil(np.log2(n + nb)))
+    # circular correlation of length >= nb wraps no shift k <= nb - n (k + t < nb for t < n);
+    # a 5-smooth length is fast for the FFT
+    size = next_fast_len(nb, real=True)
     cross = np.fft.irfft(np.fft.rfft(b, size) * np.conj(np.fft.rfft(a, size)), size)[: nb - n + 1]
     c1 = np.concatenate([[0.0], np.cumsum(b)])
     c2 = np.concatenate([[0.0], np.cumsum(b * b)])

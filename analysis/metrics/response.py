@@ -35,6 +35,7 @@ from clearance.analysis.metrics.summary import JointSummary, joint_summary
 from clearance.results import SimulationResult
 
 __all__ = [
+    "CONTINUOUS_SHARE",
     "ContactMode",
     "ContactEvent",
     "JointContactModes",
@@ -49,6 +50,10 @@ __all__ = [
     "output_peaks",
     "window_peaks",
 ]
+
+
+CONTINUOUS_SHARE = 0.05
+"""A contact event lasting this share of the drive period or longer is continuous contact (`contact_modes`)."""
 
 
 class LagMethod(enum.Enum):
@@ -436,7 +441,7 @@ def contact_modes(
     if joint not in result.joints:
         raise KeyError(f"no clearance joint {joint!r} (have {list(result.joints)})")
     if continuous_after is None:
-        continuous_after = 0.05 * drive_period(result)
+        continuous_after = CONTINUOUS_SHARE * drive_period(result)
     jr = result.joints[joint]
     t = result.times
     h = _sample_interval(t)
@@ -446,8 +451,9 @@ def contact_modes(
     code = {ContactMode.FREE_FLIGHT: 0, ContactMode.IMPACT: 1, ContactMode.CONTINUOUS: 2}
     label = np.zeros(len(t), dtype=np.int8)  # each sample's mode (code), from its whole event
     events = []
+    force = jr.force_magnitude
     for e, a, b in zip(
-        contact_events(t, jr.penetration, jr.force_magnitude, continuous_after=continuous_after),
+        contact_events(t, jr.penetration, force, continuous_after=continuous_after),
         *_event_bounds(jr.penetration),
     ):
         label[a : b + 1] = code[e.mode]
@@ -463,7 +469,7 @@ def contact_modes(
         dominant=dominant,
         fractions=fractions,
         events=tuple(events),
-        impulse=float(np.sum(jr.force_magnitude[in_contact]) * h),
+        impulse=float(np.sum(force[in_contact]) * h),
         continuous_after=float(continuous_after),
         summary=joint_summary(result, joint),
     )
