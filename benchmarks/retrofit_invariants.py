@@ -32,12 +32,12 @@ import mujoco
 import numpy as np
 from _tables import write_keeping_reading
 
-from clearance.retrofit import Backlash, RadialPlay, RetrofitOptions, SineControl, add_backlash, retrofit
-from clearance.retrofit.output import backlash_manifest_of, manifest_of, write_retrofit
-from clearance.run.backlash_readout import add_backlash_sensors
+from clearance.options import ContactMode
+from clearance.retrofit import RadialPlay, RetrofitOptions, SineControl, retrofit
+from clearance.retrofit.output import manifest_of, write_retrofit
 from clearance.run.play_candidates import end_effector
 from clearance.run.retrofitted import Retrofitted, retrofitted, simulate_retrofitted
-from clearance.run.zero_play import ZERO_BAND, ZERO_CLEARANCE, ZERO_RING_CLEARANCE, zero_play
+from clearance.run.zero_play import ZERO_CLEARANCE, ZERO_RING_CLEARANCE, backlash_at_zero, radial_at_zero, zero_play
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 from retrofit_models import HINGES, MODELS, MOTORS
@@ -75,21 +75,8 @@ def _models() -> dict[str, tuple[mujoco.MjSpec, tuple[str, ...], tuple[str, ...]
 def _edit(spec: mujoco.MjSpec, hinges, motors, kind: str) -> Retrofitted:
     play, mode = kind.split()
     if play == "radial":
-        c = ZERO_CLEARANCE if mode == "exact" else ZERO_RING_CLEARANCE
-        options = RetrofitOptions(
-            contact_mode=mode,
-            segments=None if mode == "exact" else 64,
-            sizing_duration=0.3,
-            measure_speed=False,
-            accept_inaccurate=True,
-        )
-        r = retrofit(spec, {h: RadialPlay.make(c) for h in hinges}, options)
-        return retrofitted(".", manifest_of(r), r.model, r.twin)
-    edit = add_backlash(spec, {h: Backlash(ZERO_BAND, stop=mode) for h in motors})
-    manifest = backlash_manifest_of(edit)
-    work = edit.spec.copy()
-    add_backlash_sensors(work, manifest.backlash)
-    return retrofitted(".", manifest, work.compile(), edit.twin)
+        return radial_at_zero(spec, hinges, ContactMode(mode))
+    return backlash_at_zero(spec, motors, mode)
 
 
 def _zero_play_rows(models) -> list[str]:

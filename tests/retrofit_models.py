@@ -11,16 +11,26 @@ from __future__ import annotations
 
 import math
 
-DEGREE_ARM = """<mujoco model="degree_arm">
-  <compiler angle="degree"/>
+
+def _arm(name: str, compiler: str, hip: str, elbow: str, *, lower: str = "", link: str = "", extra: str = "") -> str:
+    """A two-link arm hanging in the x-z plane (hinges about y), motors on both, a site at its tip.
+
+    Args:
+        name: the model's name. compiler: the compiler's attributes. hip, elbow: each hinge's own
+        attributes. lower: the lower body's extra attributes. link: how the geoms weigh (default:
+        1 kg and 0.5 kg). extra: elements after the actuators.
+    """
+    masses = [link or 'mass="1"', link or 'mass="0.5"']
+    return f"""<mujoco model="{name}">
+  <compiler {compiler}/>
   <option timestep="0.002"/>
   <worldbody>
     <body name="upper" pos="0 0 1">
-      <joint name="hip" axis="0 1 0" range="-20 100" damping="0.05"/>
-      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02" mass="1"/>
-      <body name="lower" pos="0.3 0 0" euler="0 30 0">
-        <joint name="elbow" axis="0 1 0" range="-160 160" damping="0.05"/>
-        <geom type="capsule" fromto="0 0 0 0.25 0 0" size="0.02" mass="0.5"/>
+      <joint name="hip" axis="0 1 0" {hip} damping="0.05"/>
+      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02" {masses[0]}/>
+      <body name="lower" pos="0.3 0 0"{lower}>
+        <joint name="elbow" axis="0 1 0" {elbow} damping="0.05"/>
+        <geom type="capsule" fromto="0 0 0 0.25 0 0" size="0.02" {masses[1]}/>
         <site name="tip" pos="0.25 0 0"/>
       </body>
     </body>
@@ -29,10 +39,19 @@ DEGREE_ARM = """<mujoco model="degree_arm">
     <motor name="hip_motor" joint="hip" ctrlrange="-4 4"/>
     <motor name="elbow_motor" joint="elbow" ctrlrange="-2 2"/>
   </actuator>
-  <sensor><jointpos name="hip_angle" joint="hip"/><jointvel name="elbow_speed" joint="elbow"/></sensor>
-  <keyframe><key name="start" qpos="0.3 -0.5" qvel="0.2 0"/></keyframe>
-</mujoco>
+{extra}</mujoco>
 """
+
+
+DEGREE_ARM = _arm(
+    "degree_arm",
+    'angle="degree"',
+    'range="-20 100"',
+    'range="-160 160"',
+    lower=' euler="0 30 0"',
+    extra='  <sensor><jointpos name="hip_angle" joint="hip"/><jointvel name="elbow_speed" joint="elbow"/></sensor>\n'
+    '  <keyframe><key name="start" qpos="0.3 -0.5" qvel="0.2 0"/></keyframe>\n',
+)
 """Degrees (MJCF's default unit, said here explicitly; most published models): the hip limited to
 -20...100 degrees, the elbow to +-160 degrees, the lower link tilted by an Euler angle in degrees
 (the keyframe's qpos is in radians: MuJoCo does not convert it)."""
@@ -40,46 +59,25 @@ DEGREE_ARM = """<mujoco model="degree_arm">
 REF = -math.pi / 2
 """The hip's reference angle in `REF_ARM` [rad]."""
 
-REF_ARM = f"""<mujoco model="ref_arm">
-  <compiler angle="radian"/>
-  <option timestep="0.002"/>
-  <worldbody>
-    <body name="upper" pos="0 0 1">
-      <joint name="hip" axis="0 1 0" ref="{REF!r}" range="-2.6 -0.5" damping="0.05"/>
-      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02" mass="1"/>
-      <body name="lower" pos="0.3 0 0">
-        <joint name="elbow" axis="0 1 0" ref="0.4" springref="1.0" stiffness="3" range="-2 2" damping="0.05"/>
-        <geom type="capsule" fromto="0 0 0 0.25 0 0" size="0.02" mass="0.5"/>
-        <site name="tip" pos="0.25 0 0"/>
-      </body>
-    </body>
-  </worldbody>
-  <actuator><motor joint="hip" ctrlrange="-4 4"/><motor joint="elbow" ctrlrange="-2 2"/></actuator>
-</mujoco>
-"""
+REF_ARM = _arm(
+    "ref_arm",
+    'angle="radian"',
+    f'ref="{REF!r}" range="-2.6 -0.5"',
+    'ref="0.4" springref="1.0" stiffness="3" range="-2 2"',
+)
 """Reference angles: the hip reads -90 degrees (in radians) at the pose as written, its range
 around it; the elbow has a reference angle and a spring pulling it towards another (springref)."""
 
 TOTAL_MASS = 2.5
 """The total mass `TOTALMASS_ARM`'s compiler scales its links to [kg]."""
 
-TOTALMASS_ARM = f"""<mujoco model="totalmass_arm">
-  <compiler angle="radian" settotalmass="{TOTAL_MASS}"/>
-  <option timestep="0.002"/>
-  <worldbody>
-    <body name="upper" pos="0 0 1">
-      <joint name="hip" axis="0 1 0" range="-0.4 1.7" damping="0.05"/>
-      <geom type="capsule" fromto="0 0 0 0.3 0 0" size="0.02" density="2000"/>
-      <body name="lower" pos="0.3 0 0">
-        <joint name="elbow" axis="0 1 0" range="-2.8 2.8" damping="0.05"/>
-        <geom type="capsule" fromto="0 0 0 0.25 0 0" size="0.02" density="2000"/>
-        <site name="tip" pos="0.25 0 0"/>
-      </body>
-    </body>
-  </worldbody>
-  <actuator><motor joint="hip" ctrlrange="-4 4"/><motor joint="elbow" ctrlrange="-2 2"/></actuator>
-</mujoco>
-"""
+TOTALMASS_ARM = _arm(
+    "totalmass_arm",
+    f'angle="radian" settotalmass="{TOTAL_MASS}"',
+    'range="-0.4 1.7"',
+    'range="-2.8 2.8"',
+    link='density="2000"',
+)
 """``settotalmass``: the compiler scales the geoms' masses so the links weigh `TOTAL_MASS` together."""
 
 ANCHOR = (-0.02, -0.22, 0.0)

@@ -77,13 +77,13 @@ def test_a_backlash_band_at_a_hinge_with_a_reference_angle_starts_centred(stop):
     for hinge in ("hip", "elbow"):
         load, motor = m.joint(hinge), m.joint(f"{hinge}__motor")
         assert m.qpos0[motor.qposadr[0]] == m.qpos0[load.qposadr[0]]  # copied, so equal
-    assert m.qpos0[m.joint("hip").qposadr[0]] == REF
+    assert m.qpos0[m.joint("hip").qposadr[0]] == REF  # the hinge's own value, as written (radians): exact
     d = mujoco.MjData(m)  # no keyframe: the model starts at qpos0
     mujoco.mj_forward(m, d)
     np.testing.assert_array_equal(d.ten_length, 0.0)  # q_load - q_motor: both bands at their centres
     assert not (d.efc_type[: d.nefc] == mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON).any()  # no stop pushes at t = 0
     # the elbow's spring keeps pulling towards its own reference on the load side
-    assert m.qpos_spring[m.joint("elbow").qposadr[0]] == 1.0
+    assert m.qpos_spring[m.joint("elbow").qposadr[0]] == 1.0  # as written: exact
     assert m.jnt_stiffness[m.joint("elbow").id] == 3.0 and m.jnt_stiffness[m.joint("elbow__motor").id] == 0.0
 
 
@@ -96,8 +96,8 @@ def test_radial_play_keeps_reference_and_spring_angles():
     m, t = r.model, r.twin
     for hinge in ("hip", "elbow"):
         qm, qt = m.joint(hinge).qposadr[0], t.joint(hinge).qposadr[0]
-        assert (m.qpos0[qm], m.qpos_spring[qm]) == (t.qpos0[qt], t.qpos_spring[qt])
-    assert m.qpos0[m.joint("hip").qposadr[0]] == REF
+        assert (m.qpos0[qm], m.qpos_spring[qm]) == (t.qpos0[qt], t.qpos_spring[qt])  # copied: exact
+    assert m.qpos0[m.joint("hip").qposadr[0]] == REF  # as written: exact
 
 
 @pytest.mark.filterwarnings("ignore:compiler attribute 'settotalmass' is deprecated")  # the model's own choice
@@ -120,6 +120,18 @@ def test_settotalmass_is_kept_by_backlash_and_by_a_pin(tmp_path):
     point = {"joint": "elbow", "play": "backlash", "amplitude": 0.5, "frequency": 1.0}
     loaded = PlayAtHinge(str(tmp_path / "arm.xml"), "tip", 0.01, RadialPlay(), Backlash(B)).loaded(point)
     assert loaded.model.nbody == loaded.twin.nbody + 1
+    # a pin cut from its donor in a settotalmass model: frozen inertials, the donor and its pin the original body
+    four_bar = FOUR_BAR.replace("<option", '<compiler settotalmass="0.9"/>\n  <option', 1)
+    exact = RetrofitOptions(contact_mode="exact", sizing_duration=0.2, measure_speed=False)
+    if _exact_available():
+        radial = retrofit(mujoco.MjSpec.from_string(four_bar), {"loop": RadialPlay()}, exact)
+        m, t = radial.model, radial.twin
+        assert t.body_mass.sum() == pytest.approx(0.9, rel=1e-12)  # the compiler's scaling: rounding only
+        for name in ("crank", "coupler"):
+            assert m.body(name).mass[0] == t.body(name).mass[0]  # compiled values written back: exact
+        pin_and_rocker = m.body("rocker").mass[0] + m.body("clr_loop__pin").mass[0]
+        assert pin_and_rocker == pytest.approx(t.body("rocker").mass[0], rel=1e-12)  # a sum: rounding only
+        assert any("rescales masses" in n for n in radial.notes)
 
 
 def _accepting(options: RetrofitOptions) -> RetrofitOptions:
@@ -196,7 +208,7 @@ def test_a_connects_residual_is_what_its_constraint_rows_solve_for():
 
 def test_a_ring_far_from_its_body_origin_is_written_to_its_nominal_geometry(tmp_path):
     """Segment centres 1.5 m from their body's origin, written in body coordinates with 6 digits, gave implied
-    clearances of 95.5-104.7 um for c = 100 um. In a bearing-centred frame they are written to 1e-8 m."""
+    clearances of 95.5-104.7 um for c = 100 um. In a bearing-centred frame they are written to 5e-8 m."""
     c = 1e-4
     r = retrofit(mujoco.MjSpec.from_string(FAR_BEARING), {"pivot": RadialPlay.make(c)}, _accepting(RING))
     paths = write_retrofit(r, tmp_path / "out")  # measures its rings after writing (check_rings)
@@ -210,7 +222,7 @@ def test_a_ring_far_from_its_body_origin_is_written_to_its_nominal_geometry(tmp_
     axes = d.site_xmat[site].reshape(3, 3)
     local = np.array([axes.T @ (d.geom_xpos[written.geom(g).id] - d.site_xpos[site]) for g in h.elements.segments])
     implied = np.hypot(local[:, 0], local[:, 1]) - h.ring.segment_radius - h.ring.journal_radius
-    # 6 digits of centimetre offsets hold 5e-9 m; 1e-3 c = 1e-7 m is 20 times that
+    # 6 digits of centimetre offsets (0.0124401) hold 5e-8 m; 1e-3 c = 1e-7 m is twice that
     np.testing.assert_allclose(implied, c, rtol=0, atol=1e-3 * c)
     # a ring bent by 2 % of c is caught: move one segment in the written file
     seg = re.search(r'<geom name="clr_pivot__seg005"[^>]* pos="([^"]+)"', text)

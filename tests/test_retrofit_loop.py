@@ -3,10 +3,12 @@ rod_slider; retrofitted there (a pin on the slider following the rod's anchor, t
 contact), it is compared with the native model with clearance at rod_slider at the same step.
 
 Measured: the effective mass 0.25 % and the peak load 4e-6 apart from the native sizing's, the
-first impact on the same step (0.228 ms), the orbit within 0.40 % of c over 0.8 ms (the pin's
-armature 2.1e-4 kg); over 20 ms 44 impacts, the eccentricity up to 1.156 c against a bound of
-1.61 c. With the connect's default impedance instead of the hardened one the pin ran 48 % of c
-off the native orbit (3 us, 1e-3 kg pin).
+first impact on the same step (0.228 ms), the orbit within 1.2 % of c over 0.8 ms (the pin a 10 %
+share of the rod's mass, 0.021 kg; the moved connect keeps the twin's softness, a 4 us time
+constant, where the native model's clearance joint is a tree joint: with the connect hardened
+to MuJoCo's largest impedance and a 1e-12 kg pin the orbit was within 0.29 %, but that pin let a
+stiff four-bar's loop open by 0.5 m, tests/test_retrofit_conventions.py); over 20 ms 36 impacts,
+the eccentricity up to 1.155 c against a bound of 1.61 c.
 """
 
 from __future__ import annotations

@@ -15,12 +15,11 @@ import pytest
 from gym_assets import gym_model
 from retrofit_models import HINGES, MODELS, MOTORS
 
-from clearance.retrofit import Backlash, RadialPlay, RetrofitOptions, SineControl, add_backlash, retrofit
-from clearance.retrofit.output import backlash_manifest_of, manifest_of
-from clearance.run.backlash_readout import add_backlash_sensors
+from clearance.options import ContactMode
+from clearance.retrofit import SineControl
 from clearance.run.play_candidates import end_effector
-from clearance.run.retrofitted import Retrofitted, retrofitted
-from clearance.run.zero_play import ZERO_BAND, ZERO_CLEARANCE, ZERO_RING_CLEARANCE, zero_play
+from clearance.run.retrofitted import Retrofitted
+from clearance.run.zero_play import backlash_at_zero, radial_at_zero, zero_play
 
 DURATION = 0.1
 """The check's span [s]."""
@@ -36,29 +35,16 @@ def _needs_plugin(kind: str) -> None:
         pytest.skip("the compiled contact plugin is not built")
 
 
-def _radial(spec: mujoco.MjSpec, joints, mode: str) -> Retrofitted:
-    c = ZERO_CLEARANCE if mode == "exact" else ZERO_RING_CLEARANCE
-    options = RetrofitOptions(
-        contact_mode=mode,
-        segments=None if mode == "exact" else 64,
-        sizing_duration=0.3,
-        measure_speed=False,
-        accept_inaccurate=True,  # this checks where the model moves, not the ring's accuracy
-    )
-    r = retrofit(spec, {j: RadialPlay.make(c) for j in joints}, options)
-    return retrofitted(".", manifest_of(r), r.model, r.twin)
-
-
-def _backlash(spec: mujoco.MjSpec, joints, stop: str) -> Retrofitted:
-    edit = add_backlash(spec, {j: Backlash(ZERO_BAND, stop=stop) for j in joints})
-    manifest = backlash_manifest_of(edit)
-    work = edit.spec.copy()
-    add_backlash_sensors(work, manifest.backlash)
-    return retrofitted(".", manifest, work.compile(), edit.twin)
+def _edit(spec: mujoco.MjSpec, kind: str, radial, backlash) -> Retrofitted:
+    play, mode = kind.split("-")
+    if play == "radial":
+        return radial_at_zero(spec, radial, ContactMode(mode))
+    return backlash_at_zero(spec, backlash, mode)
 
 
 def _check(loaded: Retrofitted, site: str) -> None:
     z = zero_play(loaded, SineControl(), DURATION, site, output_interval=ROWS)
+    # the bound: 10 x the geometric play, the sum of c or of b x the hinge-to-point distance (zero_play's docstring)
     assert z.deviation <= z.bound, (
         f"{site} drifted {z.deviation * 1e6:.3g} um from the twin (bound {z.bound * 1e6:.3g} um)"
     )
@@ -78,17 +64,13 @@ CASES = [
 def test_zero_play_reproduces_the_twin_on_hand_written_models(name, kind):
     _needs_plugin(kind)
     spec = mujoco.MjSpec.from_string(MODELS[name])
-    play, mode = kind.split("-")
-    loaded = _radial(spec, HINGES[name], mode) if play == "radial" else _backlash(spec, MOTORS[name], mode)
-    _check(loaded, "tip")
+    _check(_edit(spec, kind, HINGES[name], MOTORS[name]), "tip")
 
 
 @pytest.mark.parametrize("kind", ["radial-exact", "backlash-calibrated"])
 def test_zero_play_reproduces_the_twin_on_the_reacher(kind):
     _needs_plugin(kind)
     spec = mujoco.MjSpec.from_file(str(gym_model("reacher")))
-    play, mode = kind.split("-")
-    loaded = (
-        _radial(spec, ("joint0", "joint1"), mode) if play == "radial" else _backlash(spec, ("joint0", "joint1"), mode)
-    )
-    _check(loaded, end_effector(loaded.twin, ["joint0", "joint1"]))
+    hinges = ("joint0", "joint1")
+    loaded = _edit(spec, kind, hinges, hinges)
+    _check(loaded, end_effector(loaded.twin, list(hinges)))

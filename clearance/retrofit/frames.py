@@ -13,7 +13,7 @@ wherever the bearing sits far from its body's origin (1 m away, segment centres 
 `<frame>` (`BearingFrame.chain`): the child body's own pose, then the hinge's position and the
 bearing axes, the same numbers the child body and the journal are written with, so the ring's
 centre falls on the journal's at qpos0 and its segments sit at centimetre offsets that 6 digits
-hold to 1e-8 m.
+hold to 5e-8 m (4.4e-4 of a 0.1 mm clearance, measured).
 """
 
 from __future__ import annotations

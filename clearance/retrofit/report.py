@@ -106,7 +106,7 @@ def _added(h: RetrofittedHinge, r: Retrofit) -> list[str]:
         f"- sites: `{el.journal_site}` (body {el.journal_body}), `{el.bearing_site}` (body {el.bearing_body}, at "
         f"{_vec(np.asarray(h.frame.bearing.origin))} in its frame), both with the bearing frame's axes; the bearing "
         f"site{' and the ring' if h.ring is not None else ''} in the frame `{bearing_frame_name(h.name)}` centred on "
-        "the bearing (MuJoCo writes 6 digits: the ring's offsets from its centre keep them to 1e-8 m; checked after "
+        "the bearing (MuJoCo writes 6 digits: the ring's offsets from its centre keep them to 5e-8 m; checked after "
         "writing, within 1 % of c)",
     ]
     if h.ring is None:
