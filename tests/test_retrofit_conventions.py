@@ -192,7 +192,7 @@ def _points(poses: np.ndarray, local) -> np.ndarray:
 
 def test_a_connects_residual_is_what_its_constraint_rows_solve_for():
     """`connect_residual` (closure_violation's reader) against MuJoCo's efc_pos of the connect's three rows."""
-    from clearance.run.retrofitted import connect_residual
+    from clearance.retrofit.loop import connect_residual
 
     m = mujoco.MjModel.from_xml_string(FOUR_BAR)
     d = mujoco.MjData(m)

@@ -94,6 +94,12 @@ def rank_model_parser() -> argparse.ArgumentParser:
         default="exact",
         help="radial play's contact (default exact: the compiled plugin; calibrated fits a ring per bearing)",
     )
+    p.add_argument(
+        "--accept-inaccurate",
+        action="store_true",
+        help="rank radial play with a ring that misses its stated accuracy (its ripple bound, its calibration's "
+        "goals) instead of failing that run, as clearance retrofit --accept-inaccurate does",
+    )
     cap = math.degrees(MAX_BACKLASH) * 60
     p.add_argument(
         "--backlash-arcmin",
@@ -220,7 +226,9 @@ def _plan(args: argparse.Namespace) -> _Plan:
     plays = {k: sizes[k] for k in args.plays}
     out = check_folder(Path(args.out or f"clearance-rank-{path.stem}"))
     check_scheduler(args.scheduler)
-    runner = PlayAtHinge(str(path.resolve()), site, duration, radial, backlash, args.contact_mode)
+    runner = PlayAtHinge(
+        str(path.resolve()), site, duration, radial, backlash, args.contact_mode, args.accept_inaccurate
+    )
     points = play_points(joints, plays, args.amplitudes, args.frequencies_hz)
     return _Plan(out, runner, points, site, startup, joints)
 

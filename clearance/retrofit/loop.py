@@ -44,6 +44,7 @@ __all__ = [
     "check_connect",
     "connect_frame",
     "connect_load",
+    "connect_residual",
     "connect_softness",
     "pin_donor",
     "pin_insertion_joint",
@@ -304,3 +305,14 @@ def soften_like_twin(
     connect.solimp = list(soft.solimp)
     connect.solref = list(soft.solref)
     return Pin(share, soft)
+
+
+def connect_residual(model: mujoco.MjModel, data: mujoco.MjData, eq: int) -> float:
+    """|anchor on body1 - anchor on body2| of connect ``eq`` [m]: the size of the three constraint rows'
+    residual MuJoCo solves (``efc_pos``), from positions (after ``mj_kinematics``)."""
+    a, b = int(model.eq_obj1id[eq]), int(model.eq_obj2id[eq])
+    if model.eq_objtype[eq] == mujoco.mjtObj.mjOBJ_SITE:
+        return float(np.linalg.norm(data.site_xpos[a] - data.site_xpos[b]))
+    p1 = data.xpos[a] + data.xmat[a].reshape(3, 3) @ model.eq_data[eq, :3]
+    p2 = data.xpos[b] + data.xmat[b].reshape(3, 3) @ model.eq_data[eq, 3:6]
+    return float(np.linalg.norm(p1 - p2))

@@ -15,7 +15,7 @@ for; `actuated_hinges` lists the default candidates.
 from __future__ import annotations
 
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -111,6 +111,9 @@ class PlayAtHinge:
         radial: the play of a hinge given radial play.
         backlash: the band of a hinge given backlash.
         contact_mode: the radial play's contact ('exact', 'calibrated' or 'nominal').
+        accept_inaccurate: keep a ring that misses its stated accuracy (`RetrofitOptions`); not in
+            the repr a ranking's manifest records: it changes no run's numbers, only whether the
+            run of such a ring is refused.
     """
 
     model: str
@@ -119,6 +122,7 @@ class PlayAtHinge:
     radial: RadialPlay
     backlash: Backlash
     contact_mode: str = "exact"
+    accept_inaccurate: bool = field(default=False, repr=False)
 
     def loaded(self, point: Mapping[str, Any]) -> Retrofitted:
         """The model retrofitted at the point's hinge with the point's play, in memory.
@@ -135,7 +139,9 @@ class PlayAtHinge:
             from clearance.retrofit.pipeline import retrofit
 
             mode = ContactMode(self.contact_mode)
-            options = RetrofitOptions(contact_mode=mode, control=control, measure_speed=False)
+            options = RetrofitOptions(
+                contact_mode=mode, control=control, measure_speed=False, accept_inaccurate=self.accept_inaccurate
+            )
             done = retrofit(spec, {joint: self.radial}, options)
             return retrofitted(folder, manifest_of(done), done.model, done.twin)
         if play == "backlash":

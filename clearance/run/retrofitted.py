@@ -13,11 +13,11 @@ carries every body's world pose (``body_poses``) and, per retrofitted hinge, the
 centre in its bearing frame (the eccentricity sensor; its rate is the slides' velocities,
 whose axes are the bearing frame's), the penetration |e| - c and the net contact force on
 the journal rotated into the bearing frame; ``closure_violation`` is the largest residual of
-the model's connect equalities (`connect_residual`: what their constraint rows solve for; a
-loop closure given play ties body1's anchor to its pin, so it reads the connect's own
-softness and the journal's eccentricity reads the play). The world positions of the sites asked for (a
-site, or a body's origin where no site has the name: gymnasium's reacher names its tip a
-body) are ``outputs`` ``site/<name>/x``, ``/y`` and ``/z``. A backlash retrofit's run has no
+the model's connect equalities (`clearance.retrofit.loop.connect_residual`: what their
+constraint rows solve for; a loop closure given play ties body1's anchor to its pin, so it
+reads the connect's own softness and the journal's eccentricity reads the play). The world
+positions of the sites asked for (a site, or a body's origin where no site has the name:
+gymnasium's reacher names its tip a body) are ``outputs`` ``site/<name>/x``, ``/y`` and ``/z``. A backlash retrofit's run has no
 journals: per backlashed hinge its outputs ``backlash/<hinge>/angle`` (q_load - q_motor) and
 ``backlash/<hinge>/torque`` (the stop's torque; `clearance.run.backlash_readout`).
 """
@@ -36,6 +36,7 @@ import numpy as np
 from clearance.contact_plugin.attributes import sensor_offsets
 from clearance.results import JointResult, SimulationResult
 from clearance.retrofit.drive import Drive, drive_controls
+from clearance.retrofit.loop import connect_residual
 from clearance.retrofit.manifest import BacklashRecord, HingeRecord, RetrofitManifest, read_manifest
 from clearance.retrofit.motion import initial_data
 from clearance.retrofit.play import RetrofitError
@@ -46,7 +47,6 @@ from clearance.version import __version__
 
 __all__ = [
     "Retrofitted",
-    "connect_residual",
     "load_retrofitted",
     "point_of",
     "retrofitted",
@@ -267,17 +267,6 @@ def _first_bad(
     if first_nan < n:
         return first_nan, None, "the state became non-finite (NaN or Inf)"
     return None
-
-
-def connect_residual(model: mujoco.MjModel, data: mujoco.MjData, eq: int) -> float:
-    """|anchor on body1 - anchor on body2| of connect ``eq`` [m]: the size of the three constraint rows'
-    residual MuJoCo solves (``efc_pos``), from positions (after ``mj_kinematics``)."""
-    a, b = int(model.eq_obj1id[eq]), int(model.eq_obj2id[eq])
-    if model.eq_objtype[eq] == mujoco.mjtObj.mjOBJ_SITE:
-        return float(np.linalg.norm(data.site_xpos[a] - data.site_xpos[b]))
-    p1 = data.xpos[a] + data.xmat[a].reshape(3, 3) @ model.eq_data[eq, :3]
-    p2 = data.xpos[b] + data.xmat[b].reshape(3, 3) @ model.eq_data[eq, 3:6]
-    return float(np.linalg.norm(p1 - p2))
 
 
 class _Reader:
