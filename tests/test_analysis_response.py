@@ -234,3 +234,14 @@ def test_contact_modes_classify_an_event_over_its_whole_duration():
     early = contact_modes(res, "j", end=0.052)
     assert early.fractions[ContactMode.CONTINUOUS] == pytest.approx(70 / 520, rel=1e-12)
     assert len(early.events) == 1 and early.impulse == pytest.approx(70 * 1e-4 * 1e3, rel=1e-9)  # 1e9 N/m * 1 um
+
+
+def test_the_lag_s_fft_length_is_the_smallest_5_smooth_one():
+    """The misfit's FFT length: scipy's next_fast_len for real input, without importing scipy.fft."""
+    from scipy.fft import next_fast_len
+
+    from clearance.analysis.metrics.lag import _fast_length
+
+    rng = np.random.default_rng(3)
+    for n in [*range(1, 2000), *rng.integers(2000, 10**7, 300).tolist()]:
+        assert _fast_length(n) == next_fast_len(n, real=True)

@@ -14,7 +14,7 @@ from matplotlib.figure import Figure
 
 from clearance.analysis.figures.analysis_figures import quantity_label
 from clearance.analysis.figures.canvas import draw_series, new_figure, save_png
-from clearance.analysis.figures.time_rows import band_legend_entry
+from clearance.analysis.figures.time_rows import band_legend_entry, time_axis
 from clearance.analysis.metrics.statistics import DeviationStatistics, deviation_series
 from clearance.results import SimulationResult
 from clearance.units import format_quantity
@@ -30,7 +30,7 @@ def plot_deviation(
     *,
     path: str | Path | None = None,
 ) -> Figure:
-    """Deviation from ideal over the statistics window, its 90 % band, and distributions.
+    """Deviation from ideal over the statistics window, its 5th and 95th percentiles, and distributions.
 
     Args:
         result: run with clearance.
@@ -46,13 +46,15 @@ def plot_deviation(
     a1, a2 = fig.add_subplot(gs[0, 0]), fig.add_subplot(gs[0, 1])
     d = (y - y0) * scale
     style = {"lw": 0.7, "color": "C3", "label": "deviation y − y_ideal"}
-    band = draw_series(a1, t * 1e3, d, style=style, reach=(-stats.band90 * scale, stats.band90 * scale))
-    for v, lab in ((stats.band90, "90 % of samples within ±"), (-stats.band90, None)):
-        a1.axhline(
-            v * scale, color="k", ls="--", lw=0.9, zorder=3, label=lab and f"{lab}{stats.band90 * scale:.3g} {unit}"
-        )
+    time = time_axis(result.times)
+    lo, hi = stats.band90_low * scale, stats.band90_high * scale
+    band = draw_series(a1, t * time.scale, d, style=style, reach=(lo, hi))
+    # the 5th and 95th percentiles of the signed deviation: they bound it where it is one-sided too
+    between = f"90 % of samples between {lo:.3g} and {hi:.3g} {unit}"
+    for v, lab in ((hi, between), (lo, None)):
+        a1.axhline(v, color="k", ls="--", lw=0.9, zorder=3, label=lab)
     a1.axhline(stats.mean_signed_deviation * scale, color="C2", lw=1.0, zorder=3, label="mean (signed)")
-    a1.set_xlabel("time [ms]")
+    a1.set_xlabel(time.label)
     a1.set_ylabel(f"{label} deviation [{unit}]")
     handles, names = a1.get_legend_handles_labels()
     if band:

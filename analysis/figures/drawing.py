@@ -6,8 +6,8 @@ queues a figure call instead of making it; when the block ends the queue is draw
 process and, where asked and the system can fork, one forked child, each taking the next
 figure from a shared pipe until none is left (so the two share the work whatever each figure
 costs). `start_child` forks the child earlier, with the figures queued so far: it draws them
-while this process goes on computing (a long run's report numbers), and the figures queued
-after it are drawn here when the block ends, after this process has helped with the child's.
+while this process goes on computing (a long run's report numbers); when the block ends this
+process draws the figures queued after the start, then takes the child's that are left.
 Every figure is drawn once: the child reports the figures it finished, and any it did not
 finish (it failed, or was killed) is drawn again here, where an error is raised as usual.
 The child is always waited for, so no process outlives the call.
@@ -112,9 +112,11 @@ def figures_in_parallel(processes: int = 2) -> Iterator[None]:
         raise
     finally:
         _queue, _processes, _started = outer
-    if child is not None:
-        child.finish()
-    _draw_all(jobs, processes if child is None else 1)
+    if child is None:
+        _draw_all(jobs, processes)
+        return
+    _draw_all(jobs, 1)  # the figures only this process can draw first, then help with the child's
+    child.finish()
 
 
 def start_child() -> None:

@@ -23,7 +23,7 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import FormatStrFormatter, MaxNLocator
 
 from clearance.analysis.figures.canvas import Trace, new_figure, save_png, thin_path
-from clearance.analysis.figures.time_rows import Layout, Row, band_legend_entry, draw_time_rows
+from clearance.analysis.figures.time_rows import Layout, Row, TimeAxis, band_legend_entry, draw_time_rows, time_axis
 from clearance.analysis.metrics.response import ContactMode, JointContactModes, contact_modes
 from clearance.results import SimulationResult, atomic_write_bytes
 from clearance.units import scaled_unit
@@ -64,10 +64,10 @@ def save_figure(fig: Figure, path: str | Path, *, dpi: int = 130) -> Path:
     return Path(path)
 
 
-def _window(result: SimulationResult, startup: float) -> tuple[float, float]:
-    """The start-up window on the run's time axis [ms]."""
-    t0 = float(result.times[0]) * 1e3
-    return t0, t0 + startup * 1e3
+def _window(result: SimulationResult, startup: float, time: TimeAxis) -> tuple[float, float]:
+    """The start-up window on the run's time axis (in ``time``'s unit)."""
+    t0 = float(result.times[0]) * time.scale
+    return t0, t0 + startup * time.scale
 
 
 def on_times(times: np.ndarray, other_times: np.ndarray, values: np.ndarray) -> np.ndarray:
@@ -140,7 +140,8 @@ def plot_response(
         ("velocity", output + "_vel", "rad/s" if angular else "m/s"),
         ("acceleration", output + "_acc", "rad/s²" if angular else "m/s²"),
     ]
-    t_ms = result.times * 1e3
+    time = time_axis(result.times)
+    t_ms = result.times * time.scale
     rows = []
     for title, key, si in labels:
         y = result.outputs[key]
@@ -161,7 +162,11 @@ def plot_response(
         )
         rows.append(Row(traces, title, f"{title} [{unit}]", si, scale))
     fig, drawn, _ = draw_time_rows(
-        rows, window=_window(result, startup), cycle=startup * 1e3, layout=Layout(row_height=2.0, top=0.75)
+        rows,
+        window=_window(result, startup, time),
+        cycle=startup * time.scale,
+        layout=Layout(row_height=2.0, top=0.75),
+        time=time,
     )
     handles, names = drawn[0].main.get_legend_handles_labels()
     if any(d.band for d in drawn):
@@ -216,8 +221,9 @@ def plot_contact_force(
     """
     joints = list(result.joints)
     by_joint = {m.joint: m for m in modes} if modes is not None else {j: contact_modes(result, j) for j in joints}
-    t_ms = result.times * 1e3
-    window = _window(result, startup)
+    time = time_axis(result.times)
+    t_ms = result.times * time.scale
+    window = _window(result, startup, time)
     rows = []
     for j in joints:
         f = result.joints[j].force_magnitude
@@ -234,14 +240,14 @@ def plot_contact_force(
         )
     many = len(joints) > 4
     layout = Layout(row_height=1.45 if many else 2.0, top=1.0, groups=2 if len(joints) > 8 else 1)
-    fig, drawn, _ = draw_time_rows(rows, window=window, cycle=startup * 1e3, layout=layout)
+    fig, drawn, _ = draw_time_rows(rows, window=window, cycle=startup * time.scale, layout=layout, time=time)
     for d in drawn:
         m = by_joint[d.row.label]
         for ax in (d.main, d.zoom):
             if ax is None:
                 continue
             for mode in (ContactMode.IMPACT, ContactMode.CONTINUOUS):
-                spans = [(e.start * 1e3, e.duration * 1e3) for e in m.events if e.mode is mode]
+                spans = [(e.start * time.scale, e.duration * time.scale) for e in m.events if e.mode is mode]
                 if spans:
                     ax.broken_barh(
                         spans, (0, 1), transform=ax.get_xaxis_transform(), color=MODE_COLOURS[mode], alpha=0.22, lw=0
@@ -281,9 +287,10 @@ def plot_orbit(
     jr = result.joints[joint]
     e = jr.eccentricity * 1e6
     c = clearance * 1e6
-    t_ms = result.times * 1e3
+    time = time_axis(result.times)
+    t_ms = result.times * time.scale
     keep = thin_path(e[:, 0], e[:, 1])
-    split = (result.times[0] + startup) * 1e3
+    split = (result.times[0] + startup) * time.scale
     if split >= t_ms[-1]:  # no steady state: the whole run coloured by time
         split = float(t_ms[0])
     early, late = keep[t_ms[keep] < split], keep[t_ms[keep] >= split]
@@ -308,7 +315,7 @@ def plot_orbit(
             label = ("steady state" if startup > 0 else "run") if k == 0 else None
             ax.plot(e[idx, 0], e[idx, 1], color=cmap(k), lw=0.9, label=label)
     ax.plot(e[0, 0], e[0, 1], "o", color="C3", ms=5, label="start")
-    bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), cax=cax, label="time [ms]")
+    bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), cax=cax, label=time.label)
     ticks = MaxNLocator(nbins=6).tick_values(edges[0], edges[-1])
     bar.set_ticks([v for v in ticks if edges[0] <= v <= edges[-1]])
     bar.ax.yaxis.set_major_formatter(FormatStrFormatter("%.4g"))

@@ -19,7 +19,7 @@ from matplotlib.figure import Figure
 
 from clearance.analysis.figures.canvas import Trace, save_png
 from clearance.analysis.figures.plots import on_times, scaled, steady_peak
-from clearance.analysis.figures.time_rows import Layout, Row, band_legend_entry, draw_time_rows
+from clearance.analysis.figures.time_rows import Layout, Row, band_legend_entry, draw_time_rows, time_axis
 from clearance.analysis.metrics.reactions import ReactionSummary, reaction_magnitudes, summarise_reactions
 from clearance.results import SimulationResult
 from clearance.units import format_quantity, scaled_unit
@@ -59,7 +59,8 @@ def plot_reactions(
         raise ValueError("the result has no joint reactions (saved before they existed): rerun it")
     series = _signed(result)
     ideal_series = _signed(ideal) if ideal is not None else {}
-    t_ms = result.times * 1e3
+    time = time_axis(result.times)
+    t_ms = result.times * time.scale
     rows = []
     for name, y in series.items():
         drive = name not in result.joint_reactions
@@ -83,7 +84,8 @@ def plot_reactions(
         startup_panels=False,
     )
     t0 = float(t_ms[0]) if len(t_ms) else 0.0
-    fig, drawn, _ = draw_time_rows(rows, window=(t0, t0 + startup * 1e3), cycle=startup * 1e3, layout=layout)
+    window = (t0, t0 + startup * time.scale)
+    fig, drawn, _ = draw_time_rows(rows, window=window, cycle=startup * time.scale, layout=layout, time=time)
     handles, names = drawn[0].main.get_legend_handles_labels()
     if any(d.band for d in drawn):
         handles.append(band_legend_entry())

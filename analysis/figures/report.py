@@ -96,9 +96,19 @@ def startup_lines(window: Window) -> list[str]:
     return lines
 
 
+def _si_unit(key: str, output: str) -> str:
+    """The SI unit of an output's position, velocity or acceleration series."""
+    base = "rad" if "angle" in output else "m"
+    return base + ("/s²" if key.endswith("_acc") else "/s" if key.endswith("_vel") else "")
+
+
+def _q(v: float, unit: str) -> str:
+    return format_quantity(v, unit, digits=4)
+
+
 def _response_table(result: SimulationResult, ideal: SimulationResult, keys: list[str], window: Window) -> list[str]:
     lines = [
-        "| quantity | window | min | at [ms] | max | at [ms] | ideal min | ideal max | peak ratio |",
+        "| quantity | window | min | at | max | at | ideal min | ideal max | peak ratio |",
         "|---|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
     if window.startup > 0:
@@ -112,9 +122,11 @@ def _response_table(result: SimulationResult, ideal: SimulationResult, keys: lis
                 lines.append(f"| {key} | {name} | n/a | | n/a | | n/a | n/a | n/a |")
                 continue
             bold = "**" if name == "steady state" else ""
+            u = _si_unit(key, keys[0])
             lines.append(
-                f"| {key} | {name} | {_g(p.min_value)} | {p.min_time * 1e3:.4g} | {_g(p.max_value)} | "
-                f"{p.max_time * 1e3:.4g} | {_g(p.ideal_min)} | {_g(p.ideal_max)} | {bold}{p.peak_ratio:.3g}{bold} |"
+                f"| {key} | {name} | {_q(p.min_value, u)} | {_q(p.min_time, 's')} | {_q(p.max_value, u)} | "
+                f"{_q(p.max_time, 's')} | {_q(p.ideal_min, u)} | {_q(p.ideal_max, u)} | "
+                f"{bold}{p.peak_ratio:.3g}{bold} |"
             )
     return lines
 
@@ -140,7 +152,7 @@ def lag_lines(lag: OutputLag) -> list[str]:
     verdict = "Resolved." if lag.resolved else f"**Not resolved**: {lag.note}."
     return [
         f"{head}, over the steady state's {lag.periods} whole drive period{'s' if lag.periods != 1 else ''} "
-        f"({lag.window[0] * 1e3:.4g}–{lag.window[1] * 1e3:.4g} ms), searched within ±{lag.bound * 1e3:.4g} ms "
+        f"({_q(lag.window[0], 's')} to {_q(lag.window[1], 's')}), searched within ±{_q(lag.bound, 's')} "
         f"(an eighth of the period) on a {lag.resolution * 1e3:.2g} ms grid: **{lag.lag * 1e3:.3g} ms**{unc}; "
         f"positive means later than the ideal. Each signal alone: {per}. {verdict}",
         "",
@@ -235,7 +247,7 @@ def _deviation_lines(
     )
     lines += [
         "",
-        f"Window from t = {st.window_start * 1e3:.4g} ms: {what}. Samples are autocorrelated: compare p-values "
+        f"Window from t = {_q(st.window_start, 's')}: {what}. Samples are autocorrelated: compare p-values "
         "between runs, not as absolute levels.",
         "",
         "![deviation](deviation.png)",
@@ -370,9 +382,12 @@ def _report_lines(
     lines += _response_table(result, ideal, keys, window)
     lines += [
         "",
-        "Values in SI units (m, m/s, m/s² or rad, rad/s, rad/s²); peak ratio = max |y| / max |y_ideal| over the "
-        "same window. The figure is scaled to the steady state; triangles at an edge mark start-up samples "
-        "beyond it, shown at full scale beside.",
+        "Each value in the unit its size calls for (mm, m/s, km/s², ...); peak ratio = max |y| / max |y_ideal| "
+        "over the same window. The figure is scaled to the steady state; triangles at an edge mark start-up "
+        "samples beyond it, shown at full scale beside. A series too dense for its pixels is drawn as the band "
+        "of each pixel column's smallest and largest sample with the column means as its line (every peak "
+        "stays); where the whole run cannot be read, a zoom into the steady state (its span shaded orange) comes "
+        "beside it.",
         "",
     ]
     lines += lag_lines(joint_lag(result, ideal, output, startup=window.startup))

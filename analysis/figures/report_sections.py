@@ -96,42 +96,42 @@ def section_points(
     return k, pts[keep]
 
 
-def _fmt(v: float, spec: str = ".4g") -> str:
-    return "n/a" if not np.isfinite(v) else format(v, spec)
+def _fmt(v: float, unit: str) -> str:
+    return "n/a" if not np.isfinite(v) else format_quantity(v, unit, digits=4)
 
 
 def _column(summary: JointSummary, modes: JointContactModes) -> list[str]:
     """One column of the contact table: a window's statistics of one joint (rows: `_STATISTICS`)."""
     f = modes.fractions
     return [
-        _fmt(summary.peak_force),
-        _fmt(summary.peak_force_time * 1e3),
-        _fmt(summary.p95_force),
+        _fmt(summary.peak_force, "N"),
+        _fmt(summary.peak_force_time, "s"),
+        _fmt(summary.p95_force, "N"),
         str(summary.impacts),
         f"{summary.contact_fraction:.1%}",
-        _fmt(summary.max_penetration * 1e6, ".3g"),
+        _fmt(summary.max_penetration, "m"),
         f"{f[ContactMode.FREE_FLIGHT]:.1%}",
         f"{f[ContactMode.IMPACT]:.1%}",
         f"{f[ContactMode.CONTINUOUS]:.1%}",
         modes.dominant.value.replace("_", " "),
         str(len(modes.events)),
-        _fmt(modes.impulse),
+        _fmt(modes.impulse, "N s"),
     ]
 
 
 _STATISTICS = (
-    "peak force [N]",
-    "at [ms]",
-    "p95 force, in contact [N]",
+    "peak force",
+    "at",
+    "p95 force, in contact",
     "impacts (contact onsets)",
     "in contact",
-    "max penetration [µm]",
+    "max penetration",
     "free flight",
     "impact",
     "continuous contact",
     "dominant mode",
     "contact events starting",
-    "impulse [N s]",
+    "impulse",
 )
 
 

@@ -35,9 +35,19 @@ from clearance.analysis.figures.canvas import (
     steady_scale,
 )
 from clearance.analysis.figures.density import CROWDED_SHARE, crowding, turn_rate, zoom_span
-from clearance.units import format_quantity
+from clearance.units import format_quantity, scaled_unit
 
-__all__ = ["ZOOM_AFTER_CYCLES", "ZOOM_COLOUR", "DrawnRow", "Layout", "Row", "band_legend_entry", "draw_time_rows"]
+__all__ = [
+    "ZOOM_AFTER_CYCLES",
+    "ZOOM_COLOUR",
+    "DrawnRow",
+    "Layout",
+    "Row",
+    "TimeAxis",
+    "band_legend_entry",
+    "draw_time_rows",
+    "time_axis",
+]
 
 ZOOM_AFTER_CYCLES = 8
 """Drive cycles in a run above which one cycle is too narrow to read on the whole run's axes."""
@@ -59,11 +69,35 @@ _ROW_GAP = 0.42
 
 
 @dataclass(frozen=True)
+class TimeAxis:
+    """The unit of a figure's time axis, chosen by the run's length (ms for 36 ms, s for 6 s).
+
+    Attributes:
+        unit: ``µs``, ``ms`` or ``s``.
+        scale: display unit per second.
+    """
+
+    unit: str
+    scale: float
+
+    @property
+    def label(self) -> str:
+        """The axis label, ``time [ms]``."""
+        return f"time [{self.unit}]"
+
+
+def time_axis(times: np.ndarray) -> TimeAxis:
+    """The time axis for a run's ``times`` [s]: the unit in which its end reads between 1 and 1000."""
+    end = float(np.max(np.abs(times[[0, -1]]))) if len(times) else 1.0
+    return TimeAxis(*scaled_unit(end, "s"))
+
+
+@dataclass(frozen=True)
 class Row:
     """One row of a `draw_time_rows` figure.
 
     Attributes:
-        traces: the series, drawn in order (x in ms, y in display units); those that mark
+        traces: the series, drawn in order (x in the figure's time unit, y in display units); those that mark
             clipping are the run's, the others (an ideal twin's) are drawn beneath.
         label: the whole run's axes label (``Axes.get_label``).
         ylabel: y-axis label with its unit.
@@ -221,12 +255,12 @@ def _draw_startup(ax: Axes, row: Row, window: tuple[float, float], limits: tuple
     ax.set_facecolor("0.96")
 
 
-def _startup_note(ax: Axes, row: Row, clipped: list[Clipped]) -> None:
+def _startup_note(ax: Axes, row: Row, clipped: list[Clipped], time: TimeAxis) -> None:
     """Name the largest start-up excursion beyond the scale above the axes."""
     worst = max(clipped, key=lambda k: abs(k.peak))
     ax.set_title(
         f"start-up peak {format_quantity(worst.peak / row.scale, row.si_unit)} at "
-        f"{format_quantity(worst.peak_time * 1e-3, 's')} (off this scale)",
+        f"{format_quantity(worst.peak_time / time.scale, 's')} (off this scale)",
         loc="left",
         fontsize=7,
         pad=2,
@@ -235,20 +269,21 @@ def _startup_note(ax: Axes, row: Row, clipped: list[Clipped]) -> None:
 
 
 def draw_time_rows(
-    rows: list[Row], *, window: tuple[float, float], cycle: float, layout: Layout
+    rows: list[Row], *, window: tuple[float, float], cycle: float, layout: Layout, time: TimeAxis
 ) -> tuple[Figure, list[DrawnRow], tuple[float, float] | None]:
-    """A figure of rows sharing the time axis [ms], each with its side panels where needed.
+    """A figure of rows sharing the time axis, each with its side panels where needed.
 
     Args:
         rows: the `Row`s, top to bottom (then the next column of rows).
-        window: (start, end) of the start-up window [ms]; equal for none (the scale is then
-            the whole run's).
-        cycle: the drive period [ms] (0: none): a zoom shows one cycle where that reads.
+        window: (start, end) of the start-up window in ``time``'s unit; equal for none (the
+            scale is then the whole run's).
+        cycle: the drive period in ``time``'s unit (0: none): a zoom shows one cycle where that reads.
         layout: sizes and side panels (`Layout`).
+        time: the unit of the traces' x (`time_axis`).
 
     Returns:
-        (figure, the drawn rows, the zoom's span [ms] or None). The caller adds the title and
-        legend in the space ``layout.top`` leaves.
+        (figure, the drawn rows, the zoom's span in ``time``'s unit or None). The caller adds the
+        title and legend in the space ``layout.top`` leaves.
     """
     n = len(rows)
     per = max(1, math.ceil(n / layout.groups))
@@ -309,7 +344,7 @@ def draw_time_rows(
             if i == 0:
                 zoom_ax.set_title("zoom into the steady state\n(orange span on the left)", fontsize=8)
             if last:
-                zoom_ax.set_xlabel("time [ms]", fontsize=8)
+                zoom_ax.set_xlabel(time.label, fontsize=8)
             x += _GAP + _ZOOM_WIDTH
         if side and clipped and lim is not None:
             startup_ax = fig.add_axes(box(x + _GAP, _STARTUP_WIDTH, i))
@@ -321,15 +356,15 @@ def draw_time_rows(
             if not any(d.startup for d in drawn):  # the first (top) one names what the panels show
                 startup_ax.set_title("start-up, full scale\n(dashes: steady-state scale)", fontsize=8)
         elif clipped:
-            _startup_note(ax, row, clipped)
+            _startup_note(ax, row, clipped, time)
         if last:
-            ax.set_xlabel("time [ms]", fontsize=9)
+            ax.set_xlabel(time.label, fontsize=9)
         else:
             ax.tick_params(labelbottom=False)
         drawn.append(DrawnRow(row, ax, zoom_ax, startup_ax, lim, clipped, band))
     panels = [d.startup for d in drawn if d.startup is not None]
     if panels:  # the lowest one carries the time label
-        panels[-1].set_xlabel("time [ms]", fontsize=8)
+        panels[-1].set_xlabel(time.label, fontsize=8)
     return fig, drawn, span
 
 

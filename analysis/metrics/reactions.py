@@ -15,7 +15,9 @@ from __future__ import annotations
 
 import csv
 import io
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, fields, replace
+from functools import partial
 from pathlib import Path
 
 import numpy as np
@@ -89,11 +91,24 @@ def reaction_magnitudes(result: SimulationResult) -> dict[str, np.ndarray]:
     Joints first (in the mechanism's order), then drives (named as in the result's metadata
     ``drives``, else ``drive<k>``); a drive named like a joint is listed as ``<name> (drive)``.
     """
-    out = {j: np.sqrt(f[:, 0] ** 2 + f[:, 1] ** 2) for j, f in result.joint_reactions.items()}  # 4x hypot's speed
+    return {name: series() for name, series in _magnitude_series(result).items()}
+
+
+def _magnitude_series(result: SimulationResult) -> dict[str, Callable[[], np.ndarray]]:
+    """`reaction_magnitudes`' names, each with a function computing its series when called.
+
+    One series at a time keeps a long run's memory (and its page faults) to one array's worth.
+    """
+    out: dict[str, Callable[[], np.ndarray]] = {j: partial(_norm, f) for j, f in result.joint_reactions.items()}
     names = list(result.metadata.get("drives") or [f"drive{k}" for k in range(result.drive_torque.shape[1])])
     for k, d in enumerate(names[: result.drive_torque.shape[1]]):
-        out[d if d not in out else f"{d} (drive)"] = np.abs(result.drive_torque[:, k])
+        out[d if d not in out else f"{d} (drive)"] = partial(np.abs, result.drive_torque[:, k])
     return out
+
+
+def _norm(f: np.ndarray) -> np.ndarray:
+    """(n,) length of each row of an (n, 2) array (4 times np.hypot's speed)."""
+    return np.sqrt(f[:, 0] ** 2 + f[:, 1] ** 2)
 
 
 def reaction_statistics(
@@ -197,16 +212,16 @@ def summarise_reactions(
     Returns:
         The summaries.
     """
-    mags = reaction_magnitudes(result)
+    mags = _magnitude_series(result)
     drives = set(mags) - set(result.joint_reactions)
-    ideal_mags = reaction_magnitudes(ideal) if ideal is not None else {}
+    ideal_mags = _magnitude_series(ideal) if ideal is not None else {}
     rows = []
-    for name, m in mags.items():
+    for name, series in mags.items():
         kind = "drive" if name in drives else "joint"
-        row = reaction_statistics(result.times, m, name=name, kind=kind, startup=startup, period=period)
+        row = reaction_statistics(result.times, series(), name=name, kind=kind, startup=startup, period=period)
         if ideal is not None and name in ideal_mags:
             ist = reaction_statistics(
-                ideal.times, ideal_mags[name], name=name, kind=kind, startup=startup, period=period
+                ideal.times, ideal_mags[name](), name=name, kind=kind, startup=startup, period=period
             )
             sp, ip = row.steady_peak, ist.steady_peak
             ratio = sp / ip if np.isfinite(sp) and np.isfinite(ip) and ip > 0 else _NAN
