@@ -283,3 +283,16 @@ def test_report_figures_do_not_import_pyplot(tmp_path):
 )
 def test_numbers_are_written_for_people(value, unit, text):
     assert format_quantity(value, unit) == text
+
+
+def test_eleven_joints_fill_two_columns_each_with_its_time_axis_at_the_foot():
+    """The ten-bar with a clearance at every joint that can carry one: 11 contact rows."""
+    from dataclasses import replace
+
+    result, _ = _runs()
+    joints = {f"j{i}": result.joints["j"] for i in range(11)}
+    fig = plot_contact_force(replace(result, joints=joints), startup=T)
+    rows = [ax for ax in fig.axes if ax.get_label() in joints]
+    assert len(rows) == 11 and len({round(ax.get_position().x0, 3) for ax in rows}) == 2
+    # rows fill the first column first (6 of them); the foot of each column carries the time axis
+    assert [ax.get_label() for ax in rows if ax.get_xlabel() == "time [ms]"] == ["j5", "j10"]

@@ -22,7 +22,7 @@ from matplotlib.figure import Figure
 from matplotlib.patches import Patch
 from matplotlib.ticker import FormatStrFormatter, MaxNLocator
 
-from clearance.analysis.figures.canvas import Trace, new_figure, save_png, thin_path
+from clearance.analysis.figures.canvas import Trace, axes_pixels, new_figure, save_png, thin_path
 from clearance.analysis.figures.time_rows import Layout, Row, TimeAxis, band_legend_entry, draw_time_rows, time_axis
 from clearance.analysis.metrics.response import ContactMode, JointContactModes, contact_modes
 from clearance.results import SimulationResult, atomic_write_bytes
@@ -246,11 +246,15 @@ def plot_contact_force(
         for ax in (d.main, d.zoom):
             if ax is None:
                 continue
+            lo, hi = ax.get_xlim()
+            shown = [e for e in m.events if e.end * time.scale >= lo and e.start * time.scale <= hi]
+            # events closer than 3 pixels apart stripe the axes: fainter there
+            alpha = 0.22 if len(shown) * 3 <= axes_pixels(ax)[0] else 0.12
             for mode in (ContactMode.IMPACT, ContactMode.CONTINUOUS):
-                spans = [(e.start * time.scale, e.duration * time.scale) for e in m.events if e.mode is mode]
+                spans = [(e.start * time.scale, e.duration * time.scale) for e in shown if e.mode is mode]
                 if spans:
                     ax.broken_barh(
-                        spans, (0, 1), transform=ax.get_xaxis_transform(), color=MODE_COLOURS[mode], alpha=0.22, lw=0
+                        spans, (0, 1), transform=ax.get_xaxis_transform(), color=MODE_COLOURS[mode], alpha=alpha, lw=0
                     )
     h = fig.get_figheight()
     handles = [Patch(facecolor="white", edgecolor="0.6", label="free flight")]

@@ -321,8 +321,8 @@ def draw_time_rows(
         if lim is not None:
             ax.set_ylim(*lim)
             for tr in _run_traces(row):
-                k = _early(tr, window[1])
-                c = mark_clipped(ax, tr.x[:k], tr.y[:k], lim, colour=str(tr.style.get("color", "k")))
+                early = _early(tr, window[1])
+                c = mark_clipped(ax, tr.x[:early], tr.y[:early], lim, colour=str(tr.style.get("color", "k")))
                 if c is not None:
                     clipped.append(c)
         ax.set_ylabel(row.ylabel, fontsize=9)

@@ -9,7 +9,7 @@ Each column of a page is one run, made as ``clearance run --mechanism M --revolu
 it: the command's preparation and simulation of the run and its ideal twin (default options),
 then the report with every figure (`write_report`, the start-up window of one drive period, the
 joint reactions' summary), written into ``<work>/<mechanism>/<R>rev``. Each row of the page is one
-figure of the report, in the report's order, scaled to the column's width; a figure a run's
+figure of the report, in the report's order, scaled down to the column's width; a figure a run's
 report does not draw (a Poincaré section below its minimum of points) is named in its cell. The
 page's head names the commands and the commit.
 
@@ -55,7 +55,7 @@ MAX_ROWS = 3_000_000
 """Rows per run kept at most (two runs of 3 million rows of the press take about 4 GB)."""
 
 COLUMN_PX = 1100
-"""Width of a page's column [pixels]: each figure is scaled to it."""
+"""Width of a page's column [pixels]: a wider figure is scaled down to it."""
 
 _MARGIN = 24
 _HEAD_PX = 120
@@ -166,7 +166,8 @@ def compose(page: Page, columns: list[tuple[str, str, Path]], path: Path, commit
             f = folder / name
             if f.exists() and name in report_figures(folder):
                 im = Image.open(f).convert("RGB")
-                im = im.resize((COLUMN_PX, round(im.height * COLUMN_PX / im.width)), Image.Resampling.LANCZOS)
+                if im.width > COLUMN_PX:  # scaled down to the column, never up
+                    im = im.resize((COLUMN_PX, round(im.height * COLUMN_PX / im.width)), Image.Resampling.LANCZOS)
                 row.append(im)
             else:
                 row.append(None)
@@ -206,7 +207,7 @@ def compose(page: Page, columns: list[tuple[str, str, Path]], path: Path, commit
                 sheet.paste(im, (x, y + _LABEL_PX))
         y += h + _LABEL_PX + _MARGIN
     # a palette of 256 colours: the figures are flat colours, the page a third of the size
-    sheet.quantize(colors=256, method=Image.Quantize.MEDIANCUT, dither=Image.Dither.NONE).save(path, optimize=True)
+    sheet.quantize(colors=256, method=Image.Quantize.FASTOCTREE, dither=Image.Dither.NONE).save(path, optimize=True)
 
 
 def _commit() -> str:
