@@ -19,7 +19,7 @@ from matplotlib.collections import PolyCollection
 from clearance.analysis.chaos.poincare import MIN_SECTION_POINTS, section_warning
 from clearance.analysis.figures.analysis_figures import plot_contact_modes, plot_poincare
 from clearance.analysis.figures.canvas import thin_path, thin_series
-from clearance.analysis.figures.density import column_envelope, crowding
+from clearance.analysis.figures.density import column_envelope, crowded_columns
 from clearance.analysis.figures.plots import plot_contact_force, plot_response
 from clearance.analysis.figures.report import write_report
 from clearance.analysis.figures.report_sections import revolutions_for_sections, section_points
@@ -244,8 +244,8 @@ def test_a_fast_oscillation_is_crowded_and_drawn_as_a_band_a_slow_one_as_a_line(
     fast = 30 + 6 * np.sin(2 * np.pi * 0.277 * x)  # 277 Hz: about 5 reversals per pixel column
     slow = 30 + 6 * np.sin(2 * np.pi * x / 2000)  # the drive's 0.5 Hz
     pixel = 14.0 / 190  # the axis's range over its height in pixels
-    assert crowding(x, fast, columns=640, pixel=pixel) == 1.0
-    assert crowding(x, slow, columns=640, pixel=pixel) == 0.0
+    assert crowded_columns(x, fast, columns=640, pixel=pixel).all()
+    assert not crowded_columns(x, slow, columns=640, pixel=pixel).any()
     result, ideal = _runs()
     fig = plot_response(result, ideal, "x", startup=T)
     # the synthetic run's lone spikes are sparse: lines, no band
@@ -296,3 +296,15 @@ def test_eleven_joints_fill_two_columns_each_with_its_time_axis_at_the_foot():
     assert len(rows) == 11 and len({round(ax.get_position().x0, 3) for ax in rows}) == 2
     # rows fill the first column first (6 of them); the foot of each column carries the time axis
     assert [ax.get_label() for ax in rows if ax.get_xlabel() == "time [ms]"] == ["j5", "j10"]
+
+
+def test_a_comb_of_strokes_is_a_solid_block_lone_spikes_are_not():
+    from clearance.analysis.figures.density import SOLID_RUN, solid_columns
+
+    x = np.arange(64_000, dtype=float)  # 640 columns of 100 samples
+    y = np.zeros_like(x)
+    y[np.arange(50, 6_000, 200)] = 10.0  # a stroke to the top every second column, columns 0-59
+    y[np.arange(30_050, 64_000, 1_200)] = 10.0  # lone spikes, 12 columns apart
+    env = column_envelope(x, y, columns=640)
+    solid = solid_columns(env, (0.0, 10.0))
+    assert solid[:59].all() and not solid[60 + SOLID_RUN :].any()

@@ -29,7 +29,7 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 from matplotlib.transforms import blended_transform_factory
 
-from clearance.analysis.figures.density import CROWDED_SHARE, column_envelope, crowding
+from clearance.analysis.figures.density import CROWDED_SHARE, column_envelope, column_of, crowded_columns, solid_columns
 from clearance.results import atomic_write_bytes
 
 __all__ = [
@@ -276,42 +276,55 @@ def draw_series(
     y: np.ndarray,
     *,
     style: dict[str, Any],
-    pixel: float | None = None,
+    limits: tuple[float, float] | None = None,
     reach: tuple[float, ...] = (),
 ) -> bool:
     """Draw a time series at the axes' resolution; a crowded one as its envelope band and mean line.
 
     Up to two samples per pixel column the series is drawn as it is. Beyond, a series that a
-    line would paint solid (`density.crowding` at or above `density.CROWDED_SHARE`) is drawn as
-    the min-max band of each pixel column (translucent, beneath the other lines) with the
-    column means as its line; any other as its min-max line (`thin_series`), which covers the
-    same pixels as the full series. Every peak stays either way.
+    line would crowd (a share of `density.crowded_columns` of `density.CROWDED_SHARE` or more) is drawn as the
+    min-max band of each pixel column (translucent, beneath the other lines) with the column
+    means as its line; any other as its min-max line (`thin_series`), which covers the same
+    pixels as the full series, with the band and mean in place of the line over the blocks a
+    line would fill solid (`density.solid_columns`), if any. Every peak stays either way.
 
     Args:
         ax: the axes (placed: its pixel width sets the columns).
         x, y: (n,) the series in display units.
         style: ``Axes.plot`` keywords (``color``, ``lw``, ``label``, ``zorder``).
-        pixel: one pixel of the axes in y's unit (its y-range over its height in pixels);
-            default from the range of ``y`` and ``reach``.
+        limits: the axes' y-limits (default: the range of ``y`` and ``reach``).
         reach: other values the axes will show (lines drawn beside the series).
 
     Returns:
-        Whether the band was drawn.
+        Whether a band was drawn.
     """
     columns, rows = axes_pixels(ax)
-    if pixel is None:
+    if limits is None:
         lo = min([float(np.min(y)), *reach]) if len(y) else 0.0
         hi = max([float(np.max(y)), *reach]) if len(y) else 1.0
-        pixel = ((hi - lo) or 1.0) / rows
+        limits = (lo, hi)
     if len(x) <= 2 * columns:
         ax.plot(x, y, **style)
         return False
-    if crowding(x, y, columns=columns, pixel=pixel) < CROWDED_SHARE:
-        ax.plot(*thin_series(x, y, columns=columns), **style)
-        return False
+    pixel = ((limits[1] - limits[0]) or 1.0) / rows
     env = column_envelope(x, y, columns=columns)
     colour = style.get("color", "k")
     z = float(style.get("zorder", 2.0))
-    ax.fill_between(env.x, env.low, env.high, color=colour, alpha=BAND_ALPHA, lw=0, zorder=z - 0.3)
-    ax.plot(env.x, env.mean, **style)
+    band = dict(color=colour, alpha=BAND_ALPHA, lw=0, zorder=z - 0.3)
+    if crowded_columns(x, y, columns=columns, pixel=pixel).mean() >= CROWDED_SHARE:
+        ax.fill_between(env.x, env.low, env.high, **band)
+        ax.plot(env.x, env.mean, **style)
+        return True
+    here = solid_columns(env, limits)
+    if not here.any():
+        ax.plot(*thin_series(x, y, columns=columns), **style)
+        return False
+    # a sparse series with blocks a line fills solid: the band and the mean there, the line elsewhere
+    x0, x1 = float(x[0]), float(x[-1])
+    solid = np.zeros(columns, dtype=bool)
+    solid[column_of(env.x[here], columns=columns, start=x0, end=x1)] = True
+    ax.fill_between(env.x, env.low, env.high, where=here, **band)
+    ax.plot(env.x, np.where(here, env.mean, np.nan), **{k: v for k, v in style.items() if k != "label"})
+    tx, ty = thin_series(x, y, columns=columns)
+    ax.plot(tx, np.where(solid[column_of(tx, columns=columns, start=x0, end=x1)], np.nan, ty), **style)
     return True

@@ -8,11 +8,13 @@ run's length.
 
 Drawn as a line, a series that turns back and forth several times within a pixel column paints
 that column solid: a band that hides whatever lies beneath (the ideal curve, a threshold).
-`crowding` measures that: the share of pixel columns holding `CROWDED_TURNS` or more direction
-reversals of at least `MIN_SWING_PX` pixels. A crowded series is drawn as a translucent
-min-max band with its mean line on top (`canvas.draw_series`); a sparse one as the min-max
-line, which paints the same pixels as the full series. `zoom_span` chooses a stretch of the
-steady state short enough for the series to read as a curve, shown beside the whole run.
+`crowded_columns` finds such columns: those holding `CROWDED_TURNS` or more direction reversals
+of at least `MIN_SWING_PX` pixels. A crowded series is drawn as a
+translucent min-max band with its mean line on top (`canvas.draw_series`); a sparse one as the
+min-max line, which paints the same pixels as the full series, with the band only over the
+blocks a line would fill solid (`solid_columns`: a start-up's dense impacts beyond the scale).
+`zoom_span` chooses a stretch of the steady state short enough for the series to read as a
+curve, shown beside the whole run.
 """
 
 from __future__ import annotations
@@ -25,9 +27,13 @@ __all__ = [
     "CROWDED_SHARE",
     "CROWDED_TURNS",
     "MIN_SWING_PX",
+    "SOLID_INK",
+    "SOLID_RUN",
     "Envelope",
     "column_envelope",
-    "crowding",
+    "column_of",
+    "crowded_columns",
+    "solid_columns",
     "turn_rate",
     "zoom_span",
 ]
@@ -39,6 +45,13 @@ is within the line's own width."""
 CROWDED_TURNS = 2
 """Reversals within one pixel column from which a line paints the column along the series' whole
 swing there (a spike, or an oscillation faster than a pixel)."""
+
+SOLID_INK = 0.5
+"""Share of the axes' height a pixel column's line covers from which the column counts as inked."""
+
+SOLID_RUN = 8
+"""Columns of which half or more inked read as a solid block: vertical strokes a pixel or two
+apart (a start-up's dense impacts beyond the scale)."""
 
 CROWDED_SHARE = 0.2
 """Share of a series' pixel columns that are crowded from which the series is drawn as a band: a
@@ -137,7 +150,7 @@ def _turns(y: np.ndarray, min_swing: float) -> np.ndarray:
     return turn[swing >= min_swing]
 
 
-def crowding(
+def crowded_columns(
     x: np.ndarray,
     y: np.ndarray,
     *,
@@ -145,31 +158,62 @@ def crowding(
     pixel: float,
     start: float | None = None,
     end: float | None = None,
-) -> float:
-    """Share of the pixel columns of [start, end] that a line through the series paints solid.
+) -> np.ndarray:
+    """Which pixel columns of [start, end] a line through the series crowds.
 
-    A column is crowded when it holds `CROWDED_TURNS` or more direction reversals, each after
-    a swing of at least `MIN_SWING_PX` pixels.
+    A column is crowded when it holds `CROWDED_TURNS` or more direction reversals, each after a
+    swing of at least `MIN_SWING_PX` pixels.
 
     Args:
         x: (n,) abscissa, increasing.
         y: (n,) values.
-        columns: pixel columns of the stretch.
+        columns: pixel columns of the stretch (equal spans of x, as `column_envelope` cuts them).
         pixel: the size of one pixel in y's unit (the axis's y-range over its height in pixels).
         start, end: the stretch (default: the whole series).
 
     Returns:
-        The share, 0 to 1 (0 for fewer than two samples).
+        (columns,) booleans (all False for fewer than two samples).
     """
     sel = _window(x, start, end)
     xs, ys = x[sel], y[sel]
     if len(xs) < 2 or columns < 1:
-        return 0.0
-    turns = _turns(ys, MIN_SWING_PX * pixel)
-    lo, hi = (float(xs[0]), float(xs[-1])) if start is None or end is None else (float(start), float(end))
-    span = hi - lo if hi > lo else 1.0
-    col = np.clip(((xs[turns] - lo) / span * columns).astype(int), 0, columns - 1)
-    return float(np.mean(np.bincount(col, minlength=columns) >= CROWDED_TURNS))
+        return np.zeros(max(columns, 0), dtype=bool)
+    at = _turns(ys, MIN_SWING_PX * pixel)
+    lo = float(xs[0]) if start is None else float(start)
+    hi = float(xs[-1]) if end is None else float(end)
+    return np.bincount(column_of(xs[at], columns=columns, start=lo, end=hi), minlength=columns) >= CROWDED_TURNS
+
+
+def column_of(x: np.ndarray, *, columns: int, start: float, end: float) -> np.ndarray:
+    """The pixel column (0 .. columns - 1) of each abscissa, [start, end] cut into equal spans."""
+    span = end - start if end > start else 1.0
+    return np.clip(((np.asarray(x) - start) / span * columns).astype(int), 0, columns - 1)
+
+
+def solid_columns(envelope: Envelope, limits: tuple[float, float]) -> np.ndarray:
+    """Which columns of an envelope a line paints as part of a solid block.
+
+    A column is inked when the line covers `SOLID_INK` of the axes' height or more there (its
+    envelope clipped to ``limits``). Strokes a pixel or two apart merge into one dark block, so
+    every run of `SOLID_RUN` columns of which half or more are inked is a block.
+
+    Args:
+        envelope: the series' `Envelope` at the axes' columns.
+        limits: (low, high) of the axes' y-range.
+
+    Returns:
+        (m,) booleans, one per column of the envelope.
+    """
+    lo, hi = limits
+    height = hi - lo if hi > lo else 1.0
+    inked = ((np.minimum(envelope.high, hi) - np.maximum(envelope.low, lo)) >= SOLID_INK * height).astype(int)
+    if len(inked) < SOLID_RUN:
+        return np.zeros(len(inked), dtype=bool)
+    dense = np.convolve(inked, np.ones(SOLID_RUN, dtype=int), mode="valid") * 2 >= SOLID_RUN  # run k: k .. k+RUN-1
+    solid = np.zeros(len(inked), dtype=bool)
+    for k in np.flatnonzero(dense):
+        solid[k : k + SOLID_RUN] = True
+    return solid
 
 
 def turn_rate(x: np.ndarray, y: np.ndarray, *, pixel: float, start: float, end: float) -> float:

@@ -312,12 +312,14 @@ def plot_orbit(
     norm = BoundaryNorm(edges, 12)
     cmap = colormaps["viridis"].resampled(12)
     part = np.clip(np.searchsorted(edges, t_ms[late], side="right") - 1, 0, 11)
+    # a long run's path crosses itself many times over: thinner lines keep the crossings apart
+    width = 0.9 if len(late) < 100_000 else 0.45
     for k in range(12):
         idx = late[part == k]
         if len(idx):
             idx = np.concatenate([idx, late[part == k + 1][:1]])  # joined to the next span
             label = ("steady state" if startup > 0 else "run") if k == 0 else None
-            ax.plot(e[idx, 0], e[idx, 1], color=cmap(k), lw=0.9, label=label)
+            ax.plot(e[idx, 0], e[idx, 1], color=cmap(k), lw=width, label=label)
     ax.plot(e[0, 0], e[0, 1], "o", color="C3", ms=5, label="start")
     bar = fig.colorbar(ScalarMappable(norm=norm, cmap=cmap), cax=cax, label=time.label)
     ticks = MaxNLocator(nbins=6).tick_values(edges[0], edges[-1])

@@ -34,7 +34,7 @@ from clearance.analysis.figures.canvas import (
     new_figure,
     steady_scale,
 )
-from clearance.analysis.figures.density import CROWDED_SHARE, crowding, turn_rate, zoom_span
+from clearance.analysis.figures.density import CROWDED_SHARE, crowded_columns, turn_rate, zoom_span
 from clearance.units import format_quantity, scaled_unit
 
 __all__ = [
@@ -198,7 +198,7 @@ def _zoom_span(
     columns = int(_ZOOM_WIDTH * DPI)
     main = int(width * DPI)
     crowded = any(
-        crowding(t.x, t.y, columns=main, pixel=px, start=start, end=end) >= CROWDED_SHARE
+        crowded_columns(t.x, t.y, columns=main, pixel=px, start=start, end=end).mean() >= CROWDED_SHARE
         for r, px in zip(rows, pixels)
         for t in _run_traces(r)
     )
@@ -222,21 +222,25 @@ def _zoom_span(
     return zoom_span(t.x, t.y, start=start, end=end, cycle=cycle, columns=columns, pixel=px, centre=centre)
 
 
-def _draw_zoom(ax: Axes, row: Row, span: tuple[float, float], pixel_main: float) -> bool:
+def _draw_zoom(ax: Axes, row: Row, span: tuple[float, float]) -> bool:
     """The traces within ``span`` on their own scale; returns whether a band was drawn."""
-    band = False
-    lo, hi = np.inf, -np.inf
+    parts = []
     for tr in row.traces:
         a, b = np.searchsorted(tr.x, span[0]), np.searchsorted(tr.x, span[1], side="right")
-        if b - a < 1:
-            continue
-        ys = tr.y[a:b]
-        lo, hi = min(lo, float(np.min(ys))), max(hi, float(np.max(ys)))
+        if b > a:
+            parts.append((tr, slice(int(a), int(b))))
+    if not parts:
+        ax.set_xlim(*span)
+        return False
+    lo = min(float(np.min(tr.y[sl])) for tr, sl in parts)
+    hi = max(float(np.max(tr.y[sl])) for tr, sl in parts)
+    pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1.0) * 0.08
+    limits = (lo - pad, hi + pad)
+    band = False
+    for tr, sl in parts:
         style = {k: v for k, v in tr.style.items() if k != "label"}
-        band |= draw_series(ax, tr.x[a:b], ys, pixel=pixel_main, style=style)
-    if np.isfinite(lo) and hi > lo:
-        pad = 0.08 * (hi - lo)
-        ax.set_ylim(lo - pad, hi + pad)
+        band |= draw_series(ax, tr.x[sl], tr.y[sl], limits=limits, style=style)
+    ax.set_ylim(*limits)
     ax.set_xlim(*span)
     for side in ax.spines.values():
         side.set_edgecolor(ZOOM_COLOUR)
@@ -307,14 +311,14 @@ def draw_time_rows(
 
     drawn: list[DrawnRow] = []
     first: Axes | None = None
-    for k, (row, lim, px) in enumerate(zip(rows, limits, pixels)):
+    for k, (row, lim) in enumerate(zip(rows, limits)):
         g, i = divmod(k, per)
         x0 = g * group_w + layout.left
         ax = fig.add_axes(box(x0, layout.main_width, i), sharex=first, label=row.label)
         first = first or ax
         band = False
         for tr in row.traces:
-            band |= draw_series(ax, tr.x, tr.y, pixel=px, style=tr.style)
+            band |= draw_series(ax, tr.x, tr.y, limits=lim, style=tr.style)
         ax.locator_params(axis="y", nbins=5)  # fewer ticks: each costs a few ms to draw
         mark_startup(ax, *window, label="start-up" if i == 0 else None)
         clipped: list[Clipped] = []
@@ -336,7 +340,7 @@ def draw_time_rows(
             for edge in span:
                 ax.axvline(edge, color=ZOOM_COLOUR, lw=0.9, zorder=0.6)
             zoom_ax = fig.add_axes(box(x + _GAP, _ZOOM_WIDTH, i))
-            band |= _draw_zoom(zoom_ax, row, span, px)
+            band |= _draw_zoom(zoom_ax, row, span)
             zoom_ax.set_ylabel(row.ylabel, fontsize=7)
             zoom_ax.tick_params(labelsize=7)
             zoom_ax.locator_params(nbins=4)
