@@ -27,6 +27,7 @@ from types import MappingProxyType
 from typing import TYPE_CHECKING, Any
 
 from clearance.checks import finite, positive
+from clearance.lubrication import Lubrication
 
 if TYPE_CHECKING:  # numpy is imported where it is used: `import clearance` stays cheap
     import numpy as np
@@ -137,6 +138,10 @@ class Clearance:
         restitution: coefficient of restitution c_e in (0, 1].
         friction: Coulomb friction coefficient mu >= 0.
         law: normal contact force law.
+        bearing_length: axial length L of the bearing [m], > 0, or None where nothing
+            needs it (a lubricated joint does).
+        lubrication: the oil film of a lubricated joint (`clearance.lubrication`), or None
+            for a dry joint.
     """
 
     radial_clearance: float
@@ -147,6 +152,8 @@ class Clearance:
     restitution: float = 0.9
     friction: float = 0.0
     law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH
+    bearing_length: float | None = None
+    lubrication: Lubrication | None = None
 
     def __post_init__(self) -> None:
         rb = positive("bearing_radius", self.bearing_radius, "m")
@@ -163,6 +170,16 @@ class Clearance:
             raise ValueError(f"law must be a ContactLaw (got {self.law!r})")
         if self.journal_link is not None:
             _name("journal_link", self.journal_link)
+        if self.bearing_length is not None:
+            positive("bearing_length", self.bearing_length, "m")
+        if self.lubrication is not None:
+            if not isinstance(self.lubrication, Lubrication):
+                raise ValueError(f"lubrication must be a Lubrication (got {self.lubrication!r})")
+            if self.bearing_length is None:
+                raise ValueError("a lubricated joint needs bearing_length, the bearing's axial length [m] > 0")
+            ht = self.lubrication.transition_thickness
+            if ht >= c:
+                raise ValueError(f"lubrication transition_thickness must be < radial_clearance = {c} m (got {ht!r} m)")
 
     @property
     def journal_radius(self) -> float:
