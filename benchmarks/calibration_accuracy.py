@@ -62,7 +62,7 @@ its ends:
 - Restitution (the one miss, {max(ea):+.4f} at {a["rows"][0].speed:.3g} m/s and {min(ea):+.4f} at
   {a["rows"][-1].speed:.3g} m/s in case A, 1.7 decades of speed): N linear rows sum to a
   Hertz-like spring, but their summed damping grows like sqrt(δ)·δ̇ while LN's grows like
-  δ^1.5·δ̇/δ̇⁻ (MUJOCO_NOTES.md). The damping-to-spring force ratio is then about
+  δ^1.5·δ̇/δ̇⁻ (docs/mujoco_notes.md). The damping-to-spring force ratio is then about
   (b·a/(C·k))·δ̇/δ for the ring against χ·δ̇/δ̇⁻ for LN; with δ_max ∝ v^0.8 the ring's loss
   grows like v^0.2, so one constant b matches LN's 0.913 at one speed only (about 1 m/s here).
   The impedance rise does not change that: a row's damping scales with d(r)/d as its
@@ -305,7 +305,7 @@ def main(argv: list[str] | None = None) -> int:
         "(direct-mode solref) and impedance rise ε (solimp (d(1 − ε), d, c, 0.5, 1): each row's impedance "
         "rises linearly with its penetration from d(1 − ε) to d at the clearance c, so the row force is "
         "(d(r)/d)² k r + (d(r)/d) b ṙ; `FIT_VERSION` 2) against the LN point-mass impact (K of "
-        "REFERENCES.md §1, same effective mass). Goals: peak force and max penetration within 5 %, "
+        "docs/references.md, same effective mass). Goals: peak force and max penetration within 5 %, "
         "duration within 10 %, restitution within 0.02 of the LN impact's own (0.9132 at cₑ = 0.9). "
         "Cells: mean over the two impact directions (at a segment, between two), worst direction "
         "in brackets; bold = outside the goal.\n\n"

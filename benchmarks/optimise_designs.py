@@ -9,10 +9,10 @@ runs and takes seconds):
 - slider-crank, clearance 0.1 mm at the rod-slider joint, 2000 rpm: rod length, slider mass
   and crank length, the stroke held within 95-105 mm; objective the RMS deviation of the
   slider from its ideal curve (the fluctuation about it);
-- seven-bar press (REFERENCES.md section 4), clearances 0.1 mm at A and C, crank 2 at
-  90 rpm (3 pi rad/s, the seed's upper speed), time step 20 µs: the plate's point C (both
+- seven-bar press (the hybrid seven-bar press paper, Shock and Vibration 2020: docs/references.md), clearances 0.1 mm at A and C, crank 2 at
+  90 rpm (3 pi rad/s, the press paper's upper speed), time step 20 µs: the plate's point C (both
   coordinates) and the length of rod 5, the slider's stroke within 125-145 mm; objective the
-  RMS deviation of the slider (the seed's fluctuation of the slider's output).
+  RMS deviation of the slider (the press paper's fluctuation of the slider's output).
 
 Writes ``benchmarks/optimise_designs.md``: per problem the wall time (goal: at most 15
 minutes on 2 cores), the designs tried and simulated, the wall time and worker time per

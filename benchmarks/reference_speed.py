@@ -84,7 +84,7 @@ def speed_table(revs: float) -> list[str]:
 def method_table() -> list[str]:
     mech = slider_crank()
     period = _period(mech)
-    horizon = 1.5e-3  # first impacts, before runs separate (REFERENCES.md section 6)
+    horizon = 1.5e-3  # first impacts, before runs separate (docs/references.md, "The default scenario, measured")
     ref, _, _ = _run(mech, horizon, rtol=1e-12, method="DOP853", output_interval=1e-6)
     f_ref = ref.joints["rod_slider"].force_magnitude
     on_ref = np.array(ref.metadata["contact_onsets"]["rod_slider"])
@@ -225,8 +225,8 @@ def main(argv: list[str] | None = None) -> None:
         "- Integrator: LSODA (Adams, switching to BDF where stiff). At rtol 1e-9 it places",
         "  contact onsets and approach speeds more accurately than DOP853 at 1e-9 or 1e-10,",
         "  in fewer calls and about the same time; the implicit Radau and BDF cost 3-5x more.",
-        "- Stabilisation: coordinate projection. Baumgarte with alpha = beta = 5 1/s (the seed",
-        "  paper's values) has a 0.2 s time constant, slow against a 12 ms revolution: it only",
+        "- Stabilisation: coordinate projection. Baumgarte with alpha = beta = 5 1/s (the values of",
+        "  Flores and Ambrósio 2004) has a 0.2 s time constant, slow against a 12 ms revolution: it only",
         "  slows the drift. Projection bounds the closure error at ~2e-9 m with a handful of",
         "  projections per run, at the same cost. Energy balances are alike for all three.",
         "",

@@ -65,7 +65,7 @@ class LinkageInfo:
         driven: driven joint(s) (ground pivots of the cranks).
         output_pivot: ground pivot or guide of the output link.
         clearable: revolute joints that may carry a clearance (all but the driven ones).
-        criticality: joints of a criticality ranking (REFERENCES.md section 5): every
+        criticality: joints of a criticality ranking (Alok, Chaudhary and Guha 2020; docs/references.md): every
             revolute joint but the driven crank's and the output link's ground pivots.
         transmission: where the transmission angles are measured.
         provenance: where the dimensions come from.

@@ -69,7 +69,7 @@ SLIDER_CRANK_INFO = LinkageInfo(
     clearable=("crank_rod", "rod_slider"),
     criticality=("crank_rod", "rod_slider"),
     transmission=(TransmissionAngle("rod_slider", ("rod", "big_end"), guide="slider_guide"),),
-    provenance="Flores and Ambrosio benchmark, REFERENCES.md section 3 (crank and rod checked, "
+    provenance="the benchmark of Flores and Ambrósio 2004 (docs/references.md; crank and rod checked, "
     "masses and inertias recalled)",
 )
 
@@ -78,7 +78,7 @@ CRANK_SPEED_RANGE = (rpm(1000.0), rpm(5000.0))
 """Default speed range of the crank-driven mechanisms' sweeps [rad/s]: 1000-5000 rpm."""
 
 PRESS_SPEED_RANGE = (math.pi, 3 * math.pi)
-"""Default speed range of the press's sweeps [rad/s]: the seed's 1-3 pi rad/s (see `seven_bar_press`)."""
+"""Default speed range of the press's sweeps [rad/s]: the press paper's 1-3 pi rad/s (see `seven_bar_press`)."""
 
 
 @dataclass(frozen=True)

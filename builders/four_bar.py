@@ -1,7 +1,7 @@
 """Crank-rocker four-bar linkage.
 
-Dimensions are the project's own (the criticality study of REFERENCES.md section 5 gives
-link lengths only in figures we do not have). They were chosen for a Grashof crank-rocker
+Dimensions are the project's own (the criticality study of Alok, Chaudhary and Guha 2020,
+docs/references.md, gives link lengths only in figures we do not have). They were chosen for a Grashof crank-rocker
 (s + l = 0.17 m < p + q = 0.23 m, crank shortest) of bench size (crank 40 mm, as for the
 classic slider-crank's 50 mm) whose transmission angle stays within 44-95 deg over the
 whole revolution, comfortably inside the usual 40-140 deg design range, so that no loop

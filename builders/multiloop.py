@@ -1,10 +1,10 @@
 """An eight-bar and a ten-bar linkage (1 DOF, revolute and prismatic pairs).
 
-Both topologies and all dimensions are the project's own (REFERENCES.md section 5 and
-CLARIFICATIONS.md: the source shows its eight- and ten-bar only in figures we do not
-have). Both start from the catalogue's crank-rocker four-bar (crank 40 mm, coupler 130
-mm, rocker 100 mm, ground 130 mm) and grow by dyads, so that every loop is closed dyad by
-dyad, and both end in a slider:
+Both topologies and all dimensions are the project's own: Alok, Chaudhary and Guha 2020
+(docs/references.md) show their eight- and ten-bar only in figures we do not have. Both
+start from the catalogue's crank-rocker four-bar (crank 40 mm, coupler 130 mm, rocker 100 mm,
+ground 130 mm) and grow by dyads, so that every loop is closed dyad by dyad, and both end in
+a slider:
 
 * eight-bar (8 links, 10 joints): the Stephenson II (1) six-bar (coupler point C drives
   link 5 and ternary rocker 6), whose rocker arm E drives rod 7 and slider 8;

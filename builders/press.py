@@ -1,19 +1,20 @@
-"""The hybrid-driven seven-bar press of seed paper 000 (REFERENCES.md section 4).
+"""The hybrid-driven seven-bar press of the press paper (Shock and Vibration 2020; docs/references.md).
 
-Topology as in the seed: frame 1; crank 2 (constant-speed motor) and crank 7 (servo
+Topology as in the press paper: frame 1; crank 2 (constant-speed motor) and crank 7 (servo
 motor), both pivoted on the frame; connecting rod 3 joins crank 2 to triangle plate 4;
 plate 4 also joins crank 7 and connecting rod 5; rod 5 drives slider 6 on a vertical
-guide. 2 DOF, gravity on. The seed's clearances are A (crank 2 / rod 3) and C (plate 4 /
+guide. 2 DOF, gravity on. The press paper's clearances are A (crank 2 / rod 3) and C (plate 4 /
 rod 5); the joints carry those names.
 
-The seed's tables of dimensions, masses and speeds are not available to us: the
+The press paper's tables of dimensions, masses and speeds are not available to us: the
 dimensions are the project's own. They were picked by a grid search over crank radii,
 rod lengths, plate shape and crank phase for a press of bench size (crank 80 mm, servo
 crank 40 mm, frame pivots 350 mm apart, slider stroke about 130 mm) whose transmission
 angles stay above 68 deg over the whole cycle with both cranks turning at the same speed;
 the links are 20 mm x 20 mm steel bars (3.14 kg/m) and the slider a 1 kg block. Speeds
-follow the seed's range (crank 2 at pi rad/s by default; bifurcations over 1-3 pi rad/s);
-the servo's default period equals crank 2's (CLARIFICATIONS.md).
+follow the press paper's range (crank 2 at pi rad/s by default; bifurcations over 1-3 pi rad/s);
+the servo's default period equals crank 2's (a choice of the project: the paper's servo law is
+not available to us).
 """
 
 from __future__ import annotations
@@ -65,7 +66,8 @@ PRESS_INFO = LinkageInfo(
         TransmissionAngle("B", ("rod3", "A"), follower=("plate4", "E")),
         TransmissionAngle("D", ("rod5", "C"), guide="P6"),
     ),
-    provenance="topology from seed paper 000; project's own dimensions (its tables are not available)",
+    provenance="topology from the press paper (Shock and Vibration 2020); project's own dimensions "
+    "(its tables are not available)",
 )
 
 
@@ -129,7 +131,7 @@ def seven_bar_press(
         crank7_start_angle: crank 7 angle at t = 0 [rad] from +x.
         clearance_at, radial_clearance, bearing_radius, restitution, friction, law,
             material, gravity, name: the contact keywords (`ContactKeywords`);
-            ``clearance_at`` any of A, B, E, C, D (default the seed's A, C); ``gravity``
+            ``clearance_at`` any of A, B, E, C, D (default the press paper's A, C); ``gravity``
             9.81 m/s^2 by default.
 
     Returns:

@@ -1,6 +1,6 @@
 """The classic slider-crank of the clearance-joint literature (Flores and Ambrosio family).
 
-Default dimensions and properties follow REFERENCES.md section 3. Crank 0.05 m and rod
+Default dimensions and properties follow Flores and Ambrósio 2004, docs/references.md. Crank 0.05 m and rod
 0.12 m are checked against a public re-implementation; the masses (0.30 / 0.21 / 0.14 kg),
 moments of inertia (1e-5 / 2.5e-4 / 1e-4 kg m^2), bearing radius 10 mm, clearance 0.5 mm,
 steel (E = 207 GPa, nu = 0.3), restitution 0.9 and 5000 rpm are *recalled* values commonly

@@ -5,8 +5,8 @@ inversions differently; here they are defined by the fixed link (the numbering w
 from the kinematic-synthesis literature, not checked against a textbook): type I fixes a
 binary link that joins both ternaries, type II fixes a ternary link, type III a binary
 link next to one ternary only. Inputs, outputs, sliders and the
-variants (1) and (2) are the project's own choices (REFERENCES.md section 5 and
-CLARIFICATIONS.md: the source shows them only in figures we do not have):
+variants (1) and (2) are the project's own choices (Alok, Chaudhary and Guha 2020,
+docs/references.md, show them only in figures we do not have):
 
 * Stephenson I: ternary crank 2 and ternary rocker 4 both pivot on the ground; coupler 3
   closes the four-bar, the dyad 5-6 joins crank and rocker. With slider: rocker 4 becomes

@@ -3,8 +3,8 @@
 All three are Watt II inversions of Watt's chain (the two ternary links share a joint; here
 the ternary ground and a ternary rocker or slider): two four-bar loops in series, the first
 driven by the crank, the second by the first loop's ternary output link. Which inversion
-and where the sliders sit are the project's own choices (REFERENCES.md section 5 and
-CLARIFICATIONS.md: the source defines the variants only in figures we do not have).
+and where the sliders sit are the project's own choices (Alok, Chaudhary and Guha 2020,
+docs/references.md, define the variants only in figures we do not have).
 
 Dimensions are the project's own, of bench size like the classic slider-crank: the first
 loop is the catalogue's crank-rocker four-bar (crank 40 mm, coupler 130 mm, rocker 100 mm,

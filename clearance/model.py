@@ -51,7 +51,7 @@ __all__ = [
 
 
 class ContactLaw(enum.Enum):
-    """Normal contact force law of a clearance joint (REFERENCES.md section 1)."""
+    """Normal contact force law of a clearance joint (docs/references.md: contact laws)."""
 
     HERTZ = "hertz"
     LANKARANI_NIKRAVESH = "lankarani_nikravesh"
@@ -119,7 +119,7 @@ class Material:
 
 
 STEEL = Material(207e9, 0.3)
-"""Steel as used throughout the clearance-joint literature (REFERENCES.md section 1)."""
+"""Steel as used throughout the clearance-joint literature (docs/references.md)."""
 
 
 @dataclass(frozen=True)

@@ -26,8 +26,8 @@ class GeomType(enum.Enum):
 class ContactMode(enum.Enum):
     """How contact parameters are chosen.
 
-    NOMINAL: per-segment stiffness from the journal-bearing stiffness K (REFERENCES.md
-        section 1) spread over the ring, damping giving LN's restitution at a nominal
+    NOMINAL: per-segment stiffness from the journal-bearing stiffness K (docs/references.md)
+        spread over the ring, damping giving LN's restitution at a nominal
         impact speed; no fitting.
     CALIBRATED: parameters fitted to LN impacts (`clearance.contact_calibration`), cached.
     EXACT: every clearance joint's own contact law (any `ContactLaw`, with Ambrósio
@@ -76,7 +76,7 @@ class ModelOptions:
             benchmarks/speed_error.md).
         ripple_limit: largest force ripple allowed by the segment-count rule [-].
         impedance: constant solimp impedance d of the contact rows (small: the contact
-            then behaves as a plain spring-damper; MUJOCO_NOTES.md).
+            then behaves as a plain spring-damper; docs/mujoco_notes.md).
         closure_timeconst: time constant of ideal loop-closure equalities [s]; None for
             2 * timestep (the stiffest value MuJoCo accepts).
     """

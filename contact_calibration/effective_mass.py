@@ -21,7 +21,7 @@ scenario came much closer to the reference solver's (impacts per revolution +37 
 
 Poses come from the exact ideal kinematics (`clearance.kinematics.solve_kinematics`) over
 one drive period, mapped onto the model's qpos by Gauss–Newton on the body frames.
-CLARIFICATIONS.md: fit at the median over the cycle, keep min–max as the valid range.
+The fit is made at the median over the cycle; the min–max range is kept as the valid range.
 """
 
 from __future__ import annotations

@@ -1,11 +1,11 @@
 """Exact-LN contact inside MuJoCo: the law's force imposed on the ring's contact rows.
 
-Each step is split (MUJOCO_NOTES.md, "Exact LN inside MuJoCo"): `mj_step1` builds the
+Each step is split (docs/mujoco_notes.md, "Exact LN inside MuJoCo"): `mj_step1` builds the
 contacts; the journal's penetration δ = |e| − c and rate δ̇ = e·ė/|e| come from its
 eccentricity e in the bearing (exact circle geometry, not the polygon); the law gives one
 force F(δ, δ̇, δ̇⁻), with δ̇⁻ recorded at the first step of each contact; F is shared among
 the ring's active rows (minimum-norm non-negative row forces whose net force on the journal
-is −F e/|e|; CLARIFICATIONS.md: per-row LN would sum to the wrong law); then each row's
+is −F e/|e|; per-row LN would sum to the wrong law, roughly δ²: docs/mujoco_notes.md); then each row's
 ``efc_aref`` is set so that MuJoCo's solver returns exactly those row forces, and
 `mj_step2` integrates.
 

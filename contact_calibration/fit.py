@@ -13,7 +13,7 @@ r = c, the radial clearance; `clearance.mjcf.contact.row_solimp`) minimise, with
     (F̂/F_LN − 1)/0.05, (δ̂/δ_LN − 1)/0.05, (T̂/T_LN − 1)/0.10, (ê − e_LN)/0.02
 
 per speed and direction: each error divided by its accuracy goal, so the fit balances
-the goals. e_LN is the LN impact's own restitution (CLARIFICATIONS.md), not cₑ. The fit
+the goals. e_LN is the LN impact's own restitution (slightly above cₑ), not cₑ. The fit
 has two stages, as measured in benchmarks/ring_bounded_try.md: (log k, log b) at constant
 impedance from the nominal values, then (log k, log b, ε) with 0 ≤ ε ≤ `EPS_MAX` from
 ε = `EPS_START` and the first stage's k and b carried to full impedance.
@@ -26,7 +26,7 @@ calibrated ring's first impacts in benchmarks/ring_bounded_try.md: from −3.6�
 −3.3…+0.4 %). What stays: the rows' summed damping grows like sqrt(δ)·δ̇ while LN's grows
 like δ^1.5·δ̇/δ̇⁻, so with one b the dissipation per impact drifts with speed (1 − e ∝ v^0.2
 roughly): the fit matches restitution in the middle of the range and misses it at the
-ends (MUJOCO_NOTES.md).
+ends (docs/mujoco_notes.md).
 
 Stability: direct-mode solref is never clamped by MuJoCo, so `check_stability` verifies
 ω·h < 2 (and the damped bound h²ω² + 2hβ < 4 of the semi-implicit step) at the largest
@@ -361,7 +361,7 @@ def check_stability(
     stiffest of the checked directions) and radial damping c_t at ``max_penetration``, each
     row at the impedance of its own penetration there (``impedance_rise``), give
     ω = sqrt(k_t/m) and β = c_t/m; the semi-implicit step of a spring-damper is stable for
-    h²ω² + 2hβ < 4, which is ω·h < 2 without damping (MUJOCO_NOTES.md).
+    h²ω² + 2hβ < 4, which is ω·h < 2 without damping (docs/mujoco_notes.md).
 
     Args:
         ring: ring geometry.

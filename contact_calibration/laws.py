@@ -2,7 +2,7 @@
 
 Every law here is a pure function of the penetration δ [m], its rate δ̇ [m/s] and, for the
 dissipative laws, the normal approach speed δ̇⁻ > 0 [m/s] recorded at contact onset and kept
-for the whole impact (REFERENCES.md section 1). No MuJoCo dependency: these functions are
+for the whole impact (Lankarani and Nikravesh 1990; docs/references.md). No MuJoCo dependency: these functions are
 the independent reference the MuJoCo contact is calibrated against.
 
 Conventions:
@@ -14,7 +14,7 @@ Conventions:
   * Inputs broadcast like NumPy arrays; a 0-d result is returned as a Python float.
 
 The dissipative laws share the form F = K δⁿ [1 + χ(cₑ) δ̇/δ̇⁻]; `hysteresis_factor`
-returns χ. Hu–Guo's factor is recalled, not checked: REFERENCES.md notes that one public
+returns χ. Hu–Guo's factor is recalled, not checked: docs/references.md notes that one public
 code uses half of it, and its first use warns (`UnverifiedLawWarning`). `MIN_APPROACH_SPEED`
 is the floor on δ̇⁻ shared by every solver that records it. Ambrósio's friction thresholds
 v₀ = 1e-4 m/s and v₁ = 1e-3 m/s are recalled values (another code uses 1e-3 and 5e-2 m/s).
@@ -80,7 +80,7 @@ def _warn_unverified(law: ContactLaw) -> None:
         _warned_unverified.add(law)
         warnings.warn(
             "contact law 'hu_guo': its hysteresis factor 3(1 - c_e)/(2 c_e) is recalled, not "
-            "checked against the paper (REFERENCES.md section 1: one public code uses half this "
+            "checked against Hu and Guo 2015 (docs/references.md: one public code uses half this "
             "factor); check it before relying on the results",
             UnverifiedLawWarning,
             stacklevel=3,
@@ -122,8 +122,8 @@ def bearing_stiffness_from(
     """Contact stiffness of a journal inside a bearing.
 
     K = 4 / (3 (σ_B + σ_J)) · sqrt(R_B R_J / (R_B − R_J)),  σ = (1 − ν²)/E: the sphere-type
-    formula used throughout the clearance-joint literature (REFERENCES.md section 1,
-    [checked]; see `STIFFNESS_FORMULA`). Steel, R_B = 10 mm gives 6.61e10 N/m^1.5 at
+    formula used throughout the clearance-joint literature (Flores and Ambrósio 2004;
+    docs/references.md, [checked]; see `STIFFNESS_FORMULA`). Steel, R_B = 10 mm gives 6.61e10 N/m^1.5 at
     c = 0.5 mm.
 
     Args:
@@ -182,7 +182,7 @@ def _dissipative(
 
 
 def hertz(delta: ArrayLike, *, stiffness: float, exponent: float = 1.5) -> Force:
-    """Hertz elastic contact F = K δⁿ (REFERENCES.md section 1, table row "Hertz").
+    """Hertz elastic contact F = K δⁿ (Hertz 1882; docs/references.md).
 
     Args:
         delta: penetration δ [m], any shape; F = 0 where δ <= 0.
@@ -227,7 +227,8 @@ def lankarani_nikravesh(
 ) -> Force:
     """Lankarani–Nikravesh (1990): F = K δⁿ [1 + 3(1 − cₑ²)/4 · δ̇/δ̇⁻].
 
-    REFERENCES.md section 1 [checked]. Derived for cₑ close to 1 (good for cₑ ≳ 0.7); the
+    Lankarani and Nikravesh 1990 (docs/references.md) [checked]. Derived for cₑ close to 1
+    (good for cₑ ≳ 0.7); the
     restitution of the impact it produces is slightly above cₑ (about 0.913 at cₑ = 0.9).
 
     Args:
@@ -261,7 +262,7 @@ def hunt_crossley(
 ) -> Force:
     """Hunt–Crossley (1975): F = K δⁿ [1 + 3(1 − cₑ)/2 · δ̇/δ̇⁻].
 
-    REFERENCES.md section 1 [checked].
+    Hunt and Crossley 1975 (docs/references.md) [checked].
 
     Args:
         delta: penetration δ [m], any shape; F = 0 where δ <= 0.
@@ -294,7 +295,7 @@ def flores(
 ) -> Force:
     """Flores et al. (2011): F = K δⁿ [1 + 8(1 − cₑ)/(5cₑ) · δ̇/δ̇⁻].
 
-    REFERENCES.md section 1 [checked]; meant for the whole range of cₑ.
+    Flores, Machado, Silva and Martins 2011 (docs/references.md) [checked]; meant for the whole range of cₑ.
 
     Args:
         delta: penetration δ [m], any shape; F = 0 where δ <= 0.
@@ -327,7 +328,7 @@ def gonthier(
 ) -> Force:
     """Gonthier et al. (2004): F = K δⁿ [1 + (1 − cₑ²)/cₑ · δ̇/δ̇⁻].
 
-    REFERENCES.md section 1 [checked].
+    Gonthier, McPhee, Lange and Piedbœuf 2004 (docs/references.md) [checked].
 
     Args:
         delta: penetration δ [m], any shape; F = 0 where δ <= 0.
@@ -360,7 +361,7 @@ def hu_guo(
 ) -> Force:
     """Hu–Guo (2015): F = K δⁿ [1 + 3(1 − cₑ)/(2cₑ) · δ̇/δ̇⁻]. UNVERIFIED.
 
-    REFERENCES.md section 1 marks this factor [recalled]: one public code uses half of it.
+    Hu and Guo 2015; docs/references.md marks this factor [recalled]: one public code uses half of it.
     Check it against the paper before relying on it. The first use of the law in a process
     emits an `UnverifiedLawWarning` saying so.
 
@@ -414,7 +415,7 @@ def impact_law(
 ) -> Force:
     """MSC Adams IMPACT: F = max(0, K δⁿ + STEP(δ; 0, 0, d_max, C_max) δ̇) for δ > 0.
 
-    REFERENCES.md section 1 [checked]: STEP rises from 0 at δ = 0 to C_max at δ = d_max as
+    MSC Adams IMPACT (docs/references.md) [checked]: STEP rises from 0 at δ = 0 to C_max at δ = d_max as
     the cubic z²(3 − 2z), z = δ/d_max, and stays at C_max beyond. The max(0, ·) is the
     commercial definition (IMPACT(x, x', x1, k, e, cmax, d) = max(0, k (x1 − x)^e −
     STEP(x, x1 − d, cmax, x1, 0) x') in the Adams-derived solvers' manuals), so this law
@@ -459,7 +460,7 @@ _FACTORS = {
 
 
 def hysteresis_factor(law: ContactLaw, restitution: float) -> float:
-    """The factor χ(cₑ) of F = K δⁿ [1 + χ δ̇/δ̇⁻] (REFERENCES.md section 1).
+    """The factor χ(cₑ) of F = K δⁿ [1 + χ δ̇/δ̇⁻] (docs/references.md).
 
     LN 3(1 − cₑ²)/4; Hunt–Crossley 3(1 − cₑ)/2; Flores 8(1 − cₑ)/(5cₑ); Gonthier
     (1 − cₑ²)/cₑ; Hu–Guo 3(1 − cₑ)/(2cₑ) (recalled, unverified); Hertz 0.
@@ -548,7 +549,7 @@ def ambrosio_friction(
 ) -> Force:
     """Ambrósio's modified Coulomb friction: F_T = −μ c_d(|v_T|) F_N v_T/|v_T|.
 
-    REFERENCES.md section 2 [checked]: c_d = 0 for |v_T| <= v₀, (|v_T| − v₀)/(v₁ − v₀)
+    Ambrósio 2002 (docs/references.md) [checked]: c_d = 0 for |v_T| <= v₀, (|v_T| − v₀)/(v₁ − v₀)
     between, 1 above v₁. The defaults v₀ = 1e-4 m/s, v₁ = 1e-3 m/s are [recalled] values
     (another code uses 1e-3 and 5e-2 m/s). The law cannot stick: c_d = 0 at rest.
 
@@ -584,7 +585,7 @@ def contact_omega(stiffness: float, penetration: float, mass: float) -> float:
     """Contact frequency ω = sqrt(k_t / m) [rad/s] of the Hertz spring at a penetration.
 
     k_t = 1.5 K sqrt(δ) is the tangent stiffness of K δ^1.5 at δ. Explicit contact stepping
-    is stable for ω h < 2 (MUJOCO_NOTES.md); the run and the retrofit check their time
+    is stable for ω h < 2 (docs/mujoco_notes.md); the run and the retrofit check their time
     steps against it at the largest expected penetration.
 
     Args:

@@ -1,9 +1,9 @@
 """Nominal contact parameters of a ring bearing: no fitting, documented formulas.
 
 Stiffness: the per-row stiffness k that makes the ring of N linear rows reproduce the
-journal-bearing stiffness K of REFERENCES.md section 1 (K = 4/(3(sigma_B + sigma_J))
+journal-bearing stiffness K of the clearance-joint literature (docs/references.md: K = 4/(3(sigma_B + sigma_J))
 sqrt(R_B R_J / (R_B - R_J))), k = K / C with C the ring coefficient of
-`clearance.mjcf.bearing.ring_stiffness_coefficient` (MUJOCO_NOTES.md: a ring of linear
+`clearance.mjcf.bearing.ring_stiffness_coefficient` (docs/mujoco_notes.md: a ring of linear
 rows is already Hertz-like, F ~ delta^1.5).
 
 Damping: the constant per-row damping b for which a radial impact of the ring model at a

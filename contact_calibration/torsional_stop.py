@@ -19,7 +19,7 @@ restitution, not cₑ), at two onset phases within a step. The stop is emitted i
 solreflimit = (−K̂ Â, −B̂ Â) with Â the tendon's inverse weight at qpos0 (MuJoCo's
 ``tendon_invweight0``), and a small constant impedance, solimplimit = (d, d, 0.001, 0.5, 2)
 with d = `STOP_IMPEDANCE`: the limit is then a penalty spring-damper K̂ r + B̂ ṙ that does not
-depend on the pose (MUJOCO_NOTES.md, "Contact as a force law"), and the actuator's push
+depend on the pose (docs/mujoco_notes.md, "Contact as a force law"), and the actuator's push
 reaches it only in the share d.
 
 Why two numbers suffice: with the gear mesh's n = 1 both the law and a linear spring-damper

@@ -8,7 +8,7 @@ face tangent to the bearing circle.) The journal is a circle of radius R_J = R_B
 This module also holds the ring's force model in closed form (pure NumPy): with a linear
 spring of stiffness k on every journal-segment contact row, pushing the journal a depth
 delta into the ring engages every segment within about sqrt(2 delta / c) of the journal
-direction and the summed force grows like delta^1.5 (MUJOCO_NOTES.md). From it come the
+direction and the summed force grows like delta^1.5 (docs/mujoco_notes.md). From it come the
 per-segment stiffness that reproduces a Hertz-type stiffness K, the force ripple with
 journal direction, and the segment-count rule.
 """

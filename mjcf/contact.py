@@ -3,7 +3,7 @@
 MuJoCo's direct-mode solref ``(-S, -D)`` with a small constant impedance acts as a plain
 spring-damper of physical stiffness S / A_hat and damping D / A_hat per contact row, where
 A_hat is the row's approximate inverse inertia (the sum of the two bodies'
-``body_invweight0`` translational terms, frozen at qpos0) (MUJOCO_NOTES.md, re-measured in
+``body_invweight0`` translational terms, frozen at qpos0) (docs/mujoco_notes.md, re-measured in
 tests/test_mjcf.py). So a physical per-row stiffness k is written as S = k A_hat.
 
 The impedance may rise with each row's penetration r instead (`ContactParameters.impedance_rise`

@@ -7,7 +7,7 @@ With e the journal centre minus the bearing centre (world frame), d = |e| and n 
   * contact points: journal r_J + R_J n and bearing r_B + R_B n; the tangential relative
     velocity v_T is the relative velocity of those material points along t = (-n_y, n_x);
   * force on the journal F = -F_N n + F_T t, applied at the journal contact point; the
-    bearing gets -F at its contact point (REFERENCES.md sections 1-2; Flores and Ambrosio).
+    bearing gets -F at its contact point (Lankarani and Nikravesh 1990, Ambrósio 2002: docs/references.md).
 
 F_N follows the joint's `ContactLaw` with the approach speed delta_dot^- recorded at contact
 onset; F_T is Ambrosio's friction. The formulas are evaluated here in plain floats for speed

@@ -38,7 +38,7 @@ class Stabilisation(enum.Enum):
     """How constraint drift of the ideal joints is held down.
 
     BAUMGARTE: Baumgarte's terms in the acceleration equation (alpha = beta = 5 1/s by
-        default, as in the seed paper).
+        default, as in Flores and Ambrósio 2004).
     PROJECTION: mass-weighted projection of positions and velocities onto the constraints
         after any step whose drift exceeds 10 times the largest error weight
         (atol + rtol |y|) of a coordinate (positions) or of a velocity (velocities) at the
@@ -250,7 +250,7 @@ def run_reference(
     """Run a mechanism with the exact-geometry reference solver.
 
     Starts from the ideal mechanism assembled at t = 0 with ideal velocities, every
-    journal centred in its bearing (REFERENCES.md section 3).
+    journal centred in its bearing (Flores and Ambrósio 2004, docs/references.md).
 
     Args:
         mechanism: the mechanism (any builder's).

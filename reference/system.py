@@ -5,7 +5,7 @@ mass matrix is the constant diagonal diag(m, m, J) per link. The public entry po
 and return the link-frame coordinates q = (x, y, theta) of `clearance.kinematics` (frame
 origin, not centre of mass); `to_com` and `from_com` convert.
 
-Equations (the augmented Lagrange-multiplier form of the seed papers): the ideal joints
+Equations (the augmented Lagrange-multiplier form of the Flores–Ambrósio papers): the ideal joints
 and prescribed drives are holonomic constraints Phi(z, t) = 0 (`ConstraintRows`),
 
     M zdd + G^T lambda = Q(t, z, zd),      G zdd = gamma - 2 alpha Phi_dot - beta^2 Phi,

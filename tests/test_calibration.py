@@ -277,7 +277,7 @@ def test_cycle_effective_mass(default_prepared):
     # Along the load (the default, what prepare sizes with): at pose 0 the crank is at dead
     # centre, the rod lies along the guide and so does its load; with the crank locked the
     # rod's end can only move across the guide, so along it the journal carries the slider
-    # alone: 0.14 kg (REFERENCES.md section 3) to round-off
+    # alone: 0.14 kg (Flores and Ambrósio 2004, docs/references.md) to round-off
     load = cycle_effective_mass(p.model, p.built, p.mechanism, n_poses=12)["rod_slider"]
     assert load.values[0] == pytest.approx(0.14, rel=1e-9)
     assert load.minimum <= load.median <= load.maximum

@@ -134,7 +134,7 @@ def test_press_drives_are_configurable():
     from clearance.model import MotionLaw
 
     m = seven_bar_press(crank2_speed=2 * math.pi)
-    # CLARIFICATIONS.md: the servo's default period equals crank 2's
+    # the project's choice: the servo's default period equals crank 2's
     assert m.drives[1].period == pytest.approx(m.drives[0].period, rel=1e-15)
     law = MotionLaw(math.pi, harmonics=((0.2, 0.0),))
     m = seven_bar_press(crank7_motion=law, crank2_motion=MotionLaw(math.pi))

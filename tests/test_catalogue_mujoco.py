@@ -2,8 +2,8 @@
 mechanism x {no clearance, each single clearance, all clearances} compiles, runs one drive
 cycle without a MuJoCo warning and keeps its ideal loop closures tight.
 
-Per CLARIFICATIONS.md the matrix runs at low speed and a coarse time step: the crank at the
-catalogue's default 1000 rpm (the press at 3 pi rad/s, the top of the seed's range), 8
+The matrix runs at low speed and a coarse time step: the crank at the
+catalogue's default 1000 rpm (the press at 3 pi rad/s, the top of the press paper's range), 8
 bearing segments, and one set of contact parameters (the nominal ones of the four-bar's joint
 B) for every joint, so that the matrix fits the test budget; accuracy is measured elsewhere.
 """

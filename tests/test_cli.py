@@ -60,7 +60,7 @@ def test_reference_command(tmp_path):
     # 0.4 ms covers the first impact (about 0.25 ms after the start) and stays fast
     assert main(["reference", "--duration-ms", "0.4", "--out", str(out), "--no-progress"]) == 0
     rows = list(csv.DictReader((out / "summary.csv").open()))
-    assert float(rows[0]["peak_force"]) > 1e3  # REFERENCES.md section 3: forces of order 1e4 N
+    assert float(rows[0]["peak_force"]) > 1e3  # Flores and Ambrósio 2004, docs/references.md: forces of order 1e4 N
     assert (out / "orbit_rod_slider.png").stat().st_size > 0
 
 
@@ -183,7 +183,7 @@ def test_reference_refuses_mujoco_numerics(flag, value, tmp_path, capsys):
 
 
 def test_joint_that_never_touched_prints_no_contact(tmp_path, capsys):
-    # 0.1 ms ends before the first impact (about 0.25 ms, REFERENCES.md section 6)
+    # 0.1 ms ends before the first impact (about 0.25 ms, docs/references.md, "The default scenario, measured")
     assert main(["reference", "--duration-ms", "0.1", "--out", str(tmp_path), "--no-progress"]) == 0
     out = capsys.readouterr().out
     assert "rod_slider: no contact" in out and "max penetration" not in out

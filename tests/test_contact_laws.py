@@ -1,4 +1,4 @@
-"""Contact force laws against hand-computed values (REFERENCES.md sections 1-2).
+"""Contact force laws against hand-computed values (docs/references.md: contact laws and friction).
 
 Hand values use K = 1e10 N/m^1.5 and δ = 4e-6 m, so K δ^1.5 = 1e10 · 8e-9 = 80 N exactly;
 every expected number below is worked out by hand in plain floats. Tolerance for those:
@@ -46,7 +46,7 @@ DISSIPATIVE = {
     [(0.5e-3, "6.61e+10"), (0.25e-3, "9.47e+10"), (0.1e-3, "1.51e+11"), (0.02e-3, "3.39e+11")],
 )
 def test_bearing_stiffness_matches_reference_values(c: float, expected: str) -> None:
-    # REFERENCES.md quotes these derived values to 3 significant figures.
+    # docs/references.md quotes these derived values to 3 significant figures.
     k = bearing_stiffness(Clearance(radial_clearance=c, bearing_radius=0.010))
     assert f"{k:.2e}" == expected
 
@@ -197,7 +197,7 @@ def test_hu_guo_warns_once_that_its_factor_is_unverified(monkeypatch) -> None:
     import warnings
 
     monkeypatch.setattr(laws, "_warned_unverified", set())  # as in a fresh process
-    with pytest.warns(laws.UnverifiedLawWarning, match="REFERENCES.md section 1.*half this factor"):
+    with pytest.warns(laws.UnverifiedLawWarning, match="Hu and Guo 2015.*half this factor"):
         hysteresis_factor(ContactLaw.HU_GUO, 0.8)
     with warnings.catch_warnings():
         warnings.simplefilter("error")

@@ -38,13 +38,13 @@ needs_plugin = pytest.mark.skipif(
 )
 
 LN = ContactLaw.LANKARANI_NIKRAVESH
-K = 6.61e10  # N/m^1.5: steel, R_B = 10 mm, c = 0.5 mm (REFERENCES.md section 1)
+K = 6.61e10  # N/m^1.5: steel, R_B = 10 mm, c = 0.5 mm (docs/references.md: journal-bearing stiffness)
 C = 5e-4  # radial clearance [m]
 R_J = 9.5e-3  # journal radius [m]
 MASS = 0.15  # journal mass [kg], the effective mass of the brief's scenarios
 INERTIA = 1e-5  # journal moment of inertia [kg m^2]
 V0, V1 = 1e-4, 1e-3  # Ambrósio thresholds [m/s]
-IMPACT_C_MAX, IMPACT_D_MAX = 1e4, 1e-5  # N s/m, m (REFERENCES.md's Adams-style values)
+IMPACT_C_MAX, IMPACT_D_MAX = 1e4, 1e-5  # N s/m, m (the Adams-style values of docs/references.md, MSC Adams IMPACT)
 FULL = mujoco.mjtState.mjSTATE_FULLPHYSICS
 # State offsets inside one instance's block.
 S = {name: k for k, name in enumerate(attributes.STATE_FIELDS)}

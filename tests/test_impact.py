@@ -94,7 +94,7 @@ def test_ln_elastic_limit_conserves_energy() -> None:
 @pytest.mark.parametrize(("ce", "quoted"), [(0.9, 0.913), (0.8, 0.847)])
 def test_ln_restitution_near_ce(ce: float, quoted: float) -> None:
     r = simulate_impact(_ln(ce), mass=0.21, speed=1.0)
-    # CLARIFICATIONS: LN's own restitution is not cₑ; test the law against cₑ within 0.07.
+    # LN's own restitution is not cₑ (slightly above it); test the law against cₑ within 0.07.
     assert abs(r.restitution - ce) < 0.07
     assert r.restitution > ce  # REFERENCES: slightly above cₑ
     # The quoted values have 3 decimals: half a unit in the last place is 5e-4.
@@ -104,7 +104,7 @@ def test_ln_restitution_near_ce(ce: float, quoted: float) -> None:
 @pytest.mark.parametrize("ce", [0.85, 0.95])
 def test_ln_restitution_within_band(ce: float) -> None:
     r = law_impact(LN, mass=0.21, speed=1.0, stiffness=K_SC, restitution=ce)
-    assert ce < r.restitution < ce + 0.07  # CLARIFICATIONS band for cₑ >= 0.8
+    assert ce < r.restitution < ce + 0.07  # the project's band for cₑ >= 0.8
 
 
 def test_ln_restitution_independent_of_speed_mass_stiffness() -> None:

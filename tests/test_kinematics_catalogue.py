@@ -108,7 +108,7 @@ def test_slider_crank_against_closed_form():
     x = 0.05 * np.cos(th) + np.sqrt(0.12**2 - (0.05 * np.sin(th)) ** 2)
     # Newton tolerance 1e-12 m
     assert np.max(np.abs(kin.outputs["slider_x"] - x)) < 1e-11
-    # REFERENCES.md section 3 [derived]: -777 / +388 m/s^2 at 1000 rpm, quoted to 3 digits
+    # docs/references.md, "The classic slider-crank, ideal" [derived]: -777 / +388 m/s^2 at 1000 rpm, quoted to 3 digits
     assert kin.outputs["slider_x_acc"].min() == pytest.approx(-777, abs=0.5)
     assert kin.outputs["slider_x_acc"].max() == pytest.approx(388, abs=0.5)
 

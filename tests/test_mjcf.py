@@ -140,7 +140,7 @@ def test_body_tree_cuts_clearance_joints_first():
 
 def test_physical_row_stiffness_mapping():
     """A journal resting on the ring under a known load sinks as the per-row stiffness says."""
-    # re-measures MUJOCO_NOTES.md: physical stiffness = S / A_hat with a small impedance
+    # re-measures docs/mujoco_notes.md: physical stiffness = S / A_hat with a small impedance
     mech = slider_crank(clearance_at=("rod_slider",), crank_speed=1e-3)
     k = 2.0e7
     prep = prepare(
@@ -215,7 +215,7 @@ def test_ring_is_hertz_like_and_ripple_rule():
     g = RingGeometry.make(0.01, 0.5e-3, 160)
     d = np.array([2e-6, 2e-5])
     f = [np.hypot(*ring_force(g, np.array([0.5e-3 + x, 0.0]))) for x in d]
-    # MUJOCO_NOTES.md measured exponents 1.46-1.50 for a ring of linear rows
+    # docs/mujoco_notes.md measured exponents 1.46-1.50 for a ring of linear rows
     assert 1.40 < np.log(f[1] / f[0]) / np.log(10) < 1.55
     n = choose_segments(0.01, 0.5e-3, 6e-6)
     assert force_ripple(RingGeometry.make(0.01, 0.5e-3, n), 6e-6) < 0.02

@@ -1,7 +1,8 @@
-"""Reference solver against closed-form answers (REFERENCES.md sections 1, 3 and 6).
+"""Reference solver against closed-form answers (docs/references.md: contact laws, Flores and
+Ambrósio 2004, the default scenario measured).
 
-Short horizons throughout: the whole file runs in seconds. Error measures follow
-CLARIFICATIONS.md: max|error| / max|value| over the run; energy residual
+Short horizons throughout: the whole file runs in seconds. Error measures are
+max|error| / max|value| over the run; energy residual
 |E - E0 - W_drive - W_gravity| / max kinetic energy.
 """
 
@@ -52,7 +53,8 @@ def test_ideal_slider_crank_matches_analytic_kinematics() -> None:
 @pytest.mark.parametrize(
     ("speed_rpm", "acc_min", "acc_max", "v_peak", "acc_tol", "v_tol"),
     [
-        # REFERENCES.md section 3 table; tolerances are half a unit of its last digit
+        # the table of docs/references.md, "The classic slider-crank, ideal"; tolerances are half a
+        # unit of its last digit
         (5000, -19419, 9696, 28.41, 0.5, 0.005),
         (200, -31.1, 15.5, 1.14, 0.05, 0.005),
     ],
@@ -94,7 +96,7 @@ def test_tighter_tolerance_changes_first_impact_peaks_little() -> None:
         # each contact event's peak force (events closed within the window)
         events.append([jr.force_magnitude[a:b].max() for a, b in zip(starts, ends[ends > starts[0]])])
     n = min(map(len, events))
-    assert n >= 3  # the first impacts of the default scenario (REFERENCES.md section 6)
+    assert n >= 3  # the first impacts of the default scenario (docs/references.md, "The default scenario, measured")
     peaks = np.array([e[:n] for e in events])
     # issue goal: every first-impact peak changes by under 0.5 % (before the runs separate)
     assert np.all(np.abs(peaks[1] - peaks[0]) / peaks[1] < 0.005), peaks
@@ -104,7 +106,7 @@ def test_first_impact_time_and_size_match_reference_facts() -> None:
     res = run_reference(slider_crank(), 0.5e-3, output_interval=1e-6)
     jr = res.joints["rod_slider"]
     t_peak = res.times[np.argmax(jr.force_magnitude)]
-    # REFERENCES.md section 6: first impact about 0.25 ms after the start ("about": +-20 %)
+    # docs/references.md, "The default scenario, measured": first impact about 0.25 ms after the start ("about": +-20 %)
     assert 0.2e-3 < t_peak < 0.3e-3
     # ... contact forces of order 1e4 N, penetrations of tens of micrometres (order of mag.)
     assert 1e4 < jr.force_magnitude.max() < 1e5

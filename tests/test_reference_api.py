@@ -102,7 +102,7 @@ def test_divergence_raises_with_partial_result(mech) -> None:
         run_reference(mech, 1e-3, max_penetration=1e-6)
     err = info.value
     assert err.joint == "rod_slider"
-    assert 0.2e-3 < err.time < 0.3e-3  # during the first impact (REFERENCES.md s.6)
+    assert 0.2e-3 < err.time < 0.3e-3  # during the first impact (docs/references.md, "The default scenario, measured")
     msg = str(err)
     assert "rod_slider" in msg and "Remedy" in msg and f"{err.time:.9g}" in msg
     part = err.partial

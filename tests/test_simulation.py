@@ -23,7 +23,8 @@ def test_ideal_twin_matches_analytic_kinematics(ideal_run):
     r = ideal_run
     acc = r.outputs["slider_x_acc"]
     vel = r.outputs["slider_x_vel"]
-    # REFERENCES.md section 3 (derived): -19,419 / +9,696 m/s^2, 28.41 m/s; the issue asks 0.5 %
+    # docs/references.md, "The classic slider-crank, ideal" (derived): -19,419 / +9,696 m/s^2,
+    # 28.41 m/s; the goal is 0.5 %
     assert acc.min() == pytest.approx(-19419, rel=5e-3)
     assert acc.max() == pytest.approx(9696, rel=5e-3)
     assert np.abs(vel).max() == pytest.approx(28.41, rel=5e-3)
@@ -42,7 +43,7 @@ def test_drive_speed_within_0p1_percent(ideal_run):
 
 def test_ideal_run_has_no_contact_or_closure_error(ideal_run):
     assert ideal_run.joints == {}
-    # the ideal twin closes its loop with a connect equality (time constant 2 h); MUJOCO_NOTES.md
+    # the ideal twin closes its loop with a connect equality (time constant 2 h); docs/mujoco_notes.md
     # measured 0.34 um with a 1e-5 s time constant at 5000 rpm: 1 um bounds it
     assert 0 < np.max(ideal_run.closure_violation) < 1e-6
 
@@ -128,8 +129,8 @@ def test_deepest_penetration_is_the_ln_impact_of_the_fastest_approach(clearance_
 def test_contacts_occur(clearance_run):
     jr = clearance_run.joints["rod_slider"]
     assert np.any(jr.penetration > 0)
-    assert np.max(jr.force_magnitude) > 1e3  # REFERENCES.md section 3: forces of order 1e4 N
-    # first impact about 0.25 ms after start (REFERENCES.md section 6); 0.05 ms tolerance
+    assert np.max(jr.force_magnitude) > 1e3  # Flores and Ambrósio 2004, docs/references.md: forces of order 1e4 N
+    # first impact about 0.25 ms after start (docs/references.md, "The default scenario, measured"); 0.05 ms tolerance
     # because the ring's stiffness and the effective mass shift it slightly
     t_first = clearance_run.times[np.argmax(jr.penetration > 0)]
     assert abs(t_first - 0.25e-3) < 0.05e-3
@@ -151,7 +152,7 @@ def test_time_step_halving_first_impact_peak(default_prepared):
     from clearance.run.preparation import prepare
 
     mech = default_prepared.mechanism
-    # fixed, uncalibrated parameters (CLARIFICATIONS): nominal contact, the same at both steps
+    # fixed, uncalibrated parameters: nominal contact, the same at both steps
     params = prepare(mech, ModelOptions(contact_mode="nominal", segments=144)).contact
     assert params["rod_slider"].source == "nominal"
     peaks = []
@@ -215,7 +216,8 @@ def test_non_finite_or_warning_stops_at_the_first_bad_step(stiffness, reason):
     assert f"diverged at t = {err.time:.6g} s:" in str(err)
     # the cause is the model's state, not one joint's penetration: no joint is named
     assert err.joint is None and "at joint" not in str(err)
-    # it happens at the first contact (about 0.23 ms: REFERENCES.md section 6 gives the first
+    # it happens at the first contact (about 0.23 ms: docs/references.md, "The default scenario,
+    # measured", gives the first
     # impact at about 0.25 ms), well before the chunk ends at 0.5 ms
     assert 0.2e-3 < err.time < 0.3e-3
     p = err.partial

@@ -1,7 +1,7 @@
 """Stability suite: hard cases either run correctly or stop with a clear error, never garbage.
 
 Each case states its expected outcome. Accuracy checks compare the deterministic first
-impact with the reference solver (REFERENCES.md section 6: the first impact is the best
+impact with the reference solver (docs/references.md, "The default scenario, measured": the first impact is the best
 point-by-point check between solvers); the measured errors of every contact mode are in
 benchmarks/stability.md (python benchmarks/stability.py).
 """
@@ -99,8 +99,9 @@ def test_friction_0p3_runs_and_differs_from_ambrosio_as_documented():
     mech = slider_crank(friction=0.3)
     peak, r = _first_impact_peak(mech)
     ref = _reference_peak(mech)
-    # MuJoCo's elliptic Coulomb cone can stick, Ambrosio's law cannot (REFERENCES.md
-    # section 2): normal peaks differ by a model difference, measured -10.5 %: bound 15 %
+    # MuJoCo's elliptic Coulomb cone can stick, Ambrosio's law cannot (Ambrósio 2002,
+    # Zheng, Zhang and Wang 2018: docs/references.md): normal peaks differ by a model difference,
+    # measured -10.5 %: bound 15 %
     assert peak == pytest.approx(ref, rel=0.15)
     # friction shows up as a tangential force inside the Coulomb cone |F_t| <= mu |F_n|
     jr = r.joints["rod_slider"]
@@ -179,7 +180,7 @@ def test_time_step_too_large_is_detected_and_explained():
 # crank is at dead centre and the joint carries its peak inertia load (2.72 kN), so the
 # contact persists (a start on the opposite side is pulled out of contact at once).
 PRESSED_START = {"rod_slider": (-(0.5e-3 + 10e-6), 0.0)}
-K_DEFAULT = 6.61e10  # N/m^1.5: K of the default joint (REFERENCES.md section 1)
+K_DEFAULT = 6.61e10  # N/m^1.5: K of the default joint (docs/references.md: journal-bearing stiffness)
 
 
 def _radial_rate(jr):

@@ -1,6 +1,6 @@
 """Accuracy of a run against a reference run: first impacts point by point, the rest by statistics.
 
-Clearance-joint responses are chaotic (REFERENCES.md section 6): two exact solutions that
+Clearance-joint responses are chaotic (docs/references.md, "The default scenario, measured"): two exact solutions that
 differ only in integration details separate after a few milliseconds. So a run is compared
 with the reference in two ways:
 

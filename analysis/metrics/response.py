@@ -17,7 +17,7 @@ penetration > 0):
 
 The default ``continuous_after`` is 5 % of the drive period (an 18 degree crank arc): a
 Hertz impact of the benchmark lasts of order 0.1 ms, about 1 % of the 12 ms period at
-5000 rpm (REFERENCES.md section 3), while a journal that follows the bearing wall stays in
+5000 rpm (Flores and Ambrósio 2004, docs/references.md), while a journal that follows the bearing wall stays in
 contact for a sizeable part of the cycle. A joint's dominant mode is the mode with the
 largest share of the time in the window asked for (the whole run, the start-up window or
 the steady state).

@@ -1,6 +1,6 @@
 """Deviation statistics of an output against the ideal mechanism's output.
 
-The measures of the clearance-criticality literature (REFERENCES.md section 5): mean
+The measures of the clearance-criticality literature (Alok, Chaudhary and Guha 2020; docs/references.md): mean
 deviation, RMS deviation, 90 % tolerance band, and three two-sample tests (t-test on the
 deviation, F-test on the variances, Kolmogorov-Smirnov on the distributions: the results of
 `scipy.stats`, computed by `clearance.analysis.metrics.significance`). All are taken over a

@@ -1,6 +1,6 @@
 """Criticality of clearance joints: clearance at one joint at a time, ranked by deviation.
 
-Following REFERENCES.md section 5 (and CLARIFICATIONS "Analyses"), the candidates are all
+Following Alok, Chaudhary and Guha 2020 (docs/references.md), the candidates are all
 revolute joints except the driven crank's ground pivot and the output link's ground
 pivot. Each candidate gets the clearance alone, over a grid of clearances and drive
 speeds; the deviation of the first output from the ideal mechanism's is measured per

@@ -25,7 +25,7 @@ __all__ = ["FIXED_PER_REV", "default_scenarios", "settings_grid", "write_report"
 
 FIXED_PER_REV = {"slider_crank": 1.5}
 """Fixed wall time per revolution [s] of an exact minimal-coordinate solution of the default
-scenario on the benchmark machine (REFERENCES.md section 6), a second baseline."""
+scenario on the benchmark machine (docs/references.md, "The default scenario, measured"), a second baseline."""
 
 
 def settings_grid(

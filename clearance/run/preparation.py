@@ -254,7 +254,7 @@ def _contact_for(joint: Joint, built: BuiltModel, sizing: JointSizing, options: 
 
 
 def _check_time_step(name: str, s: JointSizing, h: float) -> None:
-    """Explicit contact stability needs omega h < 2, omega = sqrt(k_t / m_eff) (MUJOCO_NOTES.md)."""
+    """Explicit contact stability needs omega h < 2, omega = sqrt(k_t / m_eff) (docs/mujoco_notes.md)."""
     k_t = 1.5 * s.stiffness * math.sqrt(s.penetration_limit)
     omega = contact_omega(s.stiffness, s.penetration_limit, s.effective_mass)
     if omega * h >= 2.0:

@@ -1,4 +1,4 @@
-"""Findings of REFERENCES.md section 5 (criticality of clearance joints): text, figures,
+"""Findings of Alok, Chaudhary and Guha 2020; docs/references.md (criticality of clearance joints): text, figures,
 verdicts.
 
 Each ``finding_*`` function reads the criticality sweeps of `plan`, draws its figures into
@@ -110,7 +110,7 @@ whose clearance does not move the output: {"; ".join(off_path) or "none"} (in St
 5-6 closes a second loop between crank and rocker that the output does not pass through;
 their scores are 10⁻⁴ of the top one, numerical noise).
 
-Reading of the published order (REFERENCES.md §5): (a) the most critical joint is next to
+Reading of the published order (Alok, Chaudhary and Guha 2020; docs/references.md): (a) the most critical joint is next to
 the crank on the way to the output; (b) criticality falls with the distance from the crank;
 (c) the first loop's grounded joint ranks high, the other grounded joints low. Criterion:
 "holds" if (a) and (b) hold in every mechanism (over the joints that move the output),
@@ -197,7 +197,7 @@ def finding_deviation(crit, out: Path):
                 "radial clearance [mm]",
                 "mean slider deviation [mm]",
                 "deviation against clearance",
-                reference={"quoted in REFERENCES.md §5": ([0.1, 0.5], [0.05, 0.4])},
+                reference={"quoted by Alok, Chaudhary and Guha 2020": ([0.1, 0.5], [0.05, 0.4])},
             ),
             TrendPanel(
                 ratio,
@@ -205,7 +205,7 @@ def finding_deviation(crit, out: Path):
                 "mean deviation / clearance [-]",
                 "relative deviation",
                 logx=True,
-                reference={"quoted in REFERENCES.md §5": ([0.1, 0.5], [0.5, 0.8])},
+                reference={"quoted by Alok, Chaudhary and Guha 2020": ([0.1, 0.5], [0.5, 0.8])},
             ),
         ],
         title="slider-crank, clearance at the rod-slider joint",
@@ -237,7 +237,7 @@ def finding_deviation(crit, out: Path):
         )
     parts = [grows == len(cs), most_sensitive_small, lin == len(speeds)]
     verdict = HOLDS if all(parts) else PARTLY if any(parts) else FAILS
-    text = f"""The slider-crank (REFERENCES.md §3 dimensions; its masses and inertias are recalled
+    text = f"""The slider-crank (Flores and Ambrósio 2004 dimensions, docs/references.md; its masses and inertias are recalled
 values) with clearance at the rod-slider joint alone, clearances {", ".join(f"{c:g}" for c in cs_mm)} mm
 × crank speeds {", ".join(f"{rpm(s):.0f}" for s in speeds)} rpm, {plan.CRIT_PERIODS} periods at
 {plan.CRIT_STEP * 1e6:g} µs, mean |slider position − ideal| per period after the first.
@@ -256,7 +256,7 @@ deviation at {rpm(speeds[-1]):.0f} rpm to that at {rpm(speeds[0]):.0f} rpm is
 {cs_mm[int(np.argmax(sens))]:g} mm. The Watt six-bar's mean score per speed (all joints and
 clearances): {"; ".join(wspeed)}.
 
-Clearance: a straight line fits with R² ≥ 0.95 at {lin} of {len(speeds)} speeds. REFERENCES.md §5 quotes
+Clearance: a straight line fits with R² ≥ 0.95 at {lin} of {len(speeds)} speeds. Alok, Chaudhary and Guha 2020 report
 for the source's slider-crank a mean deviation of about half the clearance at 0.1 mm and
 about 80 % at 0.5 mm (its link lengths are not given; not checked against the paper by
 us); ours is {dev[speeds[0]][cs.index(1e-4)].mean_deviation / 1e-4:.2f} and

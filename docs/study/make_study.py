@@ -1,4 +1,5 @@
-"""Reproduce in kind the published clearance-joint findings (REFERENCES.md sections 4-5).
+"""Reproduce in kind the published clearance-joint findings (docs/references.md: the press paper
+of Shock and Vibration 2020 and Alok, Chaudhary and Guha 2020).
 
 Usage (from the repository root, in the project's environment)::
 

@@ -31,14 +31,14 @@ def options(step: float) -> ModelOptions:
     return ModelOptions(timestep=step, contact_mode=CONTACT)
 
 
-# -- press (REFERENCES.md section 4) -------------------------------------------------------
+# -- press (the hybrid seven-bar press paper, Shock and Vibration 2020) --------------------------
 PRESS_STEP = 10e-6  # short runs (4 periods); checked against 5 us below
 PRESS_CHECK_STEP = 5e-6
 PRESS_LONG_STEP = 20e-6  # Poincaré runs and bifurcation sweeps; checked against 10 us
 PRESS_LONG_CHECK_STEP = 10e-6
 PRESS_PERIODS = 4  # the first is the start-up transient
 KEEP_INTERVAL = 1e-4  # stored rows every 0.1 ms (peaks come from every step)
-SPEEDS = (1.0, 2.0, 3.0)  # crank 2 speed / pi rad/s (the seed's range)
+SPEEDS = (1.0, 2.0, 3.0)  # crank 2 speed / pi rad/s (the press paper's range)
 SERIES_SPEED = 3.0
 SERIES_CLEARANCES_MM = (0.01, 0.03, 0.06, 0.09, 0.2, 0.5, 0.8)
 PAIR_CLEARANCES_MM = (0.03, 0.09, 0.5)
@@ -53,7 +53,7 @@ BIF_SPEED_CLEARANCE_MM = 0.5
 BIF_PERIODS, BIF_SAMPLED = 30, 20
 BIF_CHECK_EVERY = 5  # every 5th clearance of the diagram again at 10 us
 
-# -- criticality (REFERENCES.md section 5) --------------------------------------------------
+# -- criticality (Alok, Chaudhary and Guha 2020) ---------------------------------------------------
 CRIT_STEP = 5e-6  # benchmarks/criticality_speed.md: same ranking as 1 us
 CRIT_PERIODS = 6
 FULL_GRID = ((0.02, 0.1, 0.5), (100.0, 1000.0, 3000.0))  # clearances [mm], speeds [rpm]

@@ -1,4 +1,5 @@
-"""Findings of REFERENCES.md section 4 (the seven-bar press): text, figures, verdicts.
+"""Findings of the hybrid seven-bar press paper (Shock and Vibration 2020; docs/references.md): text,
+figures, verdicts.
 
 Each ``finding_*`` function reads the runs and sweeps of `plan`, draws its figures into the
 study folder and returns (title, verdict, markdown). Verdict rules are stated in the text
@@ -247,7 +248,7 @@ was run at {h} and again at {h5} to check the step.
     }
 Ideal slider acceleration peak: {_g(ideal)} m/s². From 0.03 to 0.09 mm the acceleration peak
 goes {_g(acc[i3])} → {_g(acc[i9])} m/s² (×{acc[i9] / acc[i3]:.2f}) and the force peak {_g(force[i3])} →
-{_g(force[i9])} N (×{force[i9] / force[i3]:.2f}); the seed paper's values quoted in REFERENCES.md §4
+{_g(force[i9])} N (×{force[i9] / force[i3]:.2f}); the press paper's values quoted in docs/references.md
 are 82.9 → 137 m/s² (×1.65) and 66 → 125 N (×1.89) for its own press, whose dimensions
 and speeds we do not have. Spearman correlation with the clearance: acceleration peak
 {rho["acc"]:.2f} ({h}) and {rho["acc5"]:.2f} ({h5}), force peak {rho["f"]:.2f} and {rho["f5"]:.2f}.
@@ -260,7 +261,7 @@ and the peaks jump. The largest peak of a few periods of non-periodic motion is 
 event, not a stable statistic: at {_g(cs[iw])} mm the two steps give {_g(acc[iw])} and {_g(acc5[iw])} m/s²
 ({_g(force[iw])} and {_g(force5[iw])} N) — different impact histories — while the 95th percentile of the
 force grows smoothly. So the trend holds in kind, with a much flatter start than in the
-seed paper.
+press paper.
 """
     return "Acceleration and collision-force peaks grow with the clearance", verdict, text
 
@@ -377,7 +378,7 @@ impact) and the mean displacement deviation.
             rows,
         )
     }
-Ideal peak {_g(ideal)} m/s². The seed paper (REFERENCES.md §4) reports 94.8 m/s² with one
+Ideal peak {_g(ideal)} m/s². The press paper (Shock and Vibration 2020; docs/references.md) reports 94.8 m/s² with one
 clearance and 310.8 m/s² with two (×3.3; ideal 3.59 m/s²). Criterion: two clearances give a
 larger acceleration peak than either single one at every clearance. Two clearances give
 the largest peak at {wins} of {len(cs)} clearances, the largest RMS acceleration deviation at
@@ -500,8 +501,8 @@ section points move steadily and spread a little, and the motion turns chaotic o
 top of the range ({
         "no chaotic point" if first_chaos is None else f"from {first_chaos:.2f}π rad/s"
     }): the finding holds, but our press stays
-periodic over most of the seed's speed range at this clearance, without the flights across
-the clearance that the seed's orbits suggest.
+periodic over most of the press paper's speed range at this clearance, without the flights across
+the clearance that the press paper's orbits suggest.
 """
     return "Higher drive speed: larger collision forces, more chaotic orbits", verdict, text
 
@@ -581,7 +582,7 @@ sliding no longer repeats from one turn to the next (the journal also leaves the
 briefly, {flights[-1]:.1%} of the time after the transient), and the section points scatter
 along the loaded arc ({large.replace("_", "-")}). A closed curve needs a second frequency that does not divide
 the first: in our press both motors turn with the same period (the catalogue's default,
-CLARIFICATIONS.md), so a small clearance locks to the drive. The seed's servo motion law is
+a choice of the project), so a small clearance locks to the drive. The press paper's servo motion law is
 not available to us; if its period differs from crank 2's, a closed curve is what one
 expects even without impacts.
 """
