@@ -17,6 +17,7 @@ import inspect
 from collections.abc import Callable, Sequence
 from typing import Any, ForwardRef, TypedDict, TypeVar, Unpack, cast
 
+from clearance.lubrication import Lubrication
 from clearance.model import (
     STEEL,
     Clearance,
@@ -33,6 +34,7 @@ __all__ = [
     "CONTACT_DEFAULTS",
     "contact_keywords",
     "ClearanceFactory",
+    "lubrication_document",
 ]
 
 DEFAULT_RADIAL_CLEARANCE = 0.1e-3
@@ -53,6 +55,9 @@ class ContactKeywords(TypedDict, total=False):
         material: journal and bearing material.
         gravity: gravitational acceleration [m/s^2] along -y (0 for none).
         name: mechanism name (default: the builder's name).
+        bearing_length: axial length L [m] of every clearance joint's bearing, or None.
+        lubrication: the oil film of every clearance joint (`Lubrication`), or None for
+            dry joints; needs ``bearing_length``.
     """
 
     clearance_at: Sequence[str]
@@ -64,6 +69,8 @@ class ContactKeywords(TypedDict, total=False):
     material: Material
     gravity: float
     name: str
+    bearing_length: float | None
+    lubrication: Lubrication | None
 
 
 CONTACT_DEFAULTS: ContactKeywords = {
@@ -74,6 +81,8 @@ CONTACT_DEFAULTS: ContactKeywords = {
     "law": ContactLaw.LANKARANI_NIKRAVESH,
     "material": STEEL,
     "gravity": 0.0,
+    "bearing_length": None,
+    "lubrication": None,
 }
 """The catalogue's defaults of the contact keywords; ``clearance_at`` and ``name`` are each builder's own."""
 
@@ -172,6 +181,8 @@ class ClearanceFactory:
             restitution=contact["restitution"],
             friction=contact["friction"],
             law=law,
+            bearing_length=contact["bearing_length"],
+            lubrication=contact["lubrication"],
         )
         self.gravity = contact["gravity"]
         self.name = contact["name"]
@@ -191,6 +202,11 @@ class ClearanceFactory:
     def parameters(self) -> dict[str, Any]:
         """The contact keywords but ``name`` as JSON-friendly builder parameters."""
         c = self.template
+        extra: dict[str, Any] = {}
+        if c.bearing_length is not None:
+            extra["bearing_length"] = c.bearing_length
+        if c.lubrication is not None:
+            extra["lubrication"] = lubrication_document(c.lubrication)
         return {
             "clearance_at": list(self.joints),
             "radial_clearance": c.radial_clearance,
@@ -203,4 +219,14 @@ class ClearanceFactory:
                 "poisson_ratio": c.bearing_material.poisson_ratio,
             },
             "gravity": float(self.gravity),
+            **extra,
         }
+
+
+def lubrication_document(lubrication: Lubrication) -> dict[str, Any]:
+    """A `Lubrication` as a TOML-ready table in SI units (the keys a scenario file reads)."""
+    return {
+        "viscosity_pa_s": lubrication.viscosity,
+        "film": lubrication.film.value,
+        "transition_thickness_m": lubrication.transition_thickness,
+    }

@@ -5,7 +5,8 @@ its name where the argument has one (``crank_speed_rpm``, ``radial_clearance_mm`
 ``start_angle_deg``, ``rocker6_pivot_mm = [270, -20]``); ``clearance_mm`` is an alias of
 ``radial_clearance_mm``. ``law`` is a contact-law name, ``material`` a table
 (youngs_modulus_gpa, poisson_ratio), a ``*_motion`` argument a table (speed_rad_per_s,
-harmonics_rad, period_s).
+harmonics_rad, period_s), ``lubrication`` a table (viscosity_<pa_s|mpa_s>, film = "short" or
+"long", transition_thickness_<m|mm|um|nm>; see `read_lubrication`).
 
 A number with a unit must lie in the range `clearance.builders._toml_reader.RANGES` gives its
 quantity (or be 0, which the builder then accepts or refuses): a crank of 1e-300 m or a rod
@@ -21,10 +22,11 @@ from typing import Any
 
 from clearance.builders._toml_reader import Table
 from clearance.kinematics import AssemblyError
+from clearance.lubrication import DEFAULT_TRANSITION_THICKNESS, FilmModel, Lubrication
 from clearance.model import ContactLaw, Material, Mechanism, MotionLaw
 from clearance.units import UNITS, describe_units, quantity_of
 
-__all__ = ["from_builder"]
+__all__ = ["from_builder", "read_lubrication"]
 
 _ALIASES = {"clearance": "radial_clearance"}
 
@@ -54,6 +56,22 @@ def _match(key: str, params: list[str]) -> tuple[str, float] | None:
         p, q, unit = bad
         raise ValueError(f"bad unit '{unit}' ({describe_units(p, q)})")
     return None
+
+
+def read_lubrication(t: Table) -> Lubrication:
+    """A ``lubrication`` table as a `Lubrication` (oil viscosity, film model, transition thickness).
+
+    Raises:
+        ScenarioError: a missing viscosity, a bad unit or value, an unknown film model or key.
+    """
+    viscosity = t.number("viscosity", "viscosity")
+    film = FilmModel(t.text("film", default=FilmModel.SHORT.value, choices=[f.value for f in FilmModel]))
+    ht = t.number("transition_thickness", "film_thickness", DEFAULT_TRANSITION_THICKNESS)
+    t.finish(["viscosity_<pa_s|mpa_s>", "film", "transition_thickness_<m|mm|um|nm>"])
+    try:
+        return Lubrication(viscosity, film, ht)
+    except ValueError as e:
+        raise t.error(None, str(e)) from None
 
 
 def _accepted(params: list[str]) -> list[str]:
@@ -88,6 +106,8 @@ def _convert(t: Table, key: str, param: str, factor: float, value: Any) -> Any:
         )
         sub.finish(["youngs_modulus_<pa|mpa|gpa>", "poisson_ratio"])
         return m
+    if param == "lubrication":
+        return read_lubrication(Table(value, t.loc + (key,), f"{t.label} [{key}]", t.locator))
     if param.endswith("_motion"):
         sub = Table(value, t.loc + (key,), f"{t.label} [{key}]", t.locator)
         harmonics = tuple(sub.convert_pair("harmonics_rad", h, 1.0) for h in sub.raw("harmonics_rad", []))

@@ -12,7 +12,8 @@ or describes the whole mechanism: ``[mechanism]`` (name, ground, gravity_m_per_s
 optional ``[mechanism.parameters]``), ``[[links]]`` (name, mass_kg, inertia_kg_m2, com_m,
 position_guess_m, angle_guess_rad, ``points_m``), ``[[joints]]`` (name, kind, link_a,
 point_a, link_b, point_b, axis, optional ``[joints.clearance]`` with radial_clearance_mm,
-bearing_radius_mm, journal_link, restitution, friction, law and materials), ``[[drives]]``
+bearing_radius_mm, journal_link, restitution, friction, law, materials, bearing_length_mm and a
+``[joints.clearance.lubrication]`` table for an oiled joint), ``[[drives]]``
 (name, joint, kind, speed_rpm, start_angle_deg, torque_n_m, optional ``[drives.motion]``)
 and ``[[outputs]]`` (name, link, kind, point). Units are part of the key names; any
 length, angle or speed unit of `clearance.units.UNITS` may be used. Files are
@@ -34,7 +35,8 @@ from typing import Any, TypeVar
 
 import tomli_w
 
-from clearance.builders._scenario_builder import from_builder
+from clearance.builders._contact import lubrication_document
+from clearance.builders._scenario_builder import from_builder, read_lubrication
 from clearance.builders._toml_reader import Locator, ScenarioError, Table
 from clearance.kinematics import AssemblyError, SingularPositionError, assemble
 from clearance.model import (
@@ -252,6 +254,9 @@ def _joint(t: Table, links: dict[str, Link]) -> Joint:
         journal = c.text("journal_link", default="") or None
         if journal is not None and journal not in (la, lb):
             raise c.error("journal_link", f"must be '{la}' or '{lb}' (got '{journal}')")
+        length = c.number("bearing_length", "length", 0.0) or None
+        oil = c.sub("lubrication", "lubrication")
+        lubrication = None if oil is None else read_lubrication(oil)
         clearance = _wrap(
             c,
             None,
@@ -264,6 +269,8 @@ def _joint(t: Table, links: dict[str, Link]) -> Joint:
                 c.plain("restitution", 0.9),
                 c.plain("friction", 0.0),
                 ContactLaw(c.text("law", default=ContactLaw.LANKARANI_NIKRAVESH.value, choices=_LAWS)),
+                bearing_length=length,
+                lubrication=lubrication,
             ),
         )
         c.finish(
@@ -276,6 +283,8 @@ def _joint(t: Table, links: dict[str, Link]) -> Joint:
                 "law",
                 "bearing_material",
                 "journal_material",
+                "bearing_length_<m|mm|um>",
+                "lubrication",
             ]
         )
     t.finish(["name", "kind", "link_a", "point_a", "link_b", "point_b", "axis", "clearance"])
@@ -367,6 +376,10 @@ def scenario_document(mechanism: Mechanism) -> dict[str, Any]:
                 "bearing_material": _material_doc(c.bearing_material),
                 "journal_material": _material_doc(c.journal_material),
             }
+            if c.bearing_length is not None:
+                d["clearance"]["bearing_length_m"] = c.bearing_length
+            if c.lubrication is not None:
+                d["clearance"]["lubrication"] = lubrication_document(c.lubrication)
         joints.append(d)
     drives = []
     for dr in mechanism.drives:

@@ -27,6 +27,8 @@ UNITS: dict[str, dict[str, float]] = {
     "acceleration": {"m_per_s2": 1.0},
     "pressure": {"pa": 1.0, "mpa": 1e6, "gpa": 1e9},
     "torque": {"n_m": 1.0},
+    "viscosity": {"pa_s": 1.0, "mpa_s": 1e-3},
+    "film_thickness": {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9},
 }
 """Quantity -> unit suffix -> factor to SI."""
 
@@ -44,6 +46,8 @@ _NAMES = {
     "acceleration": "an acceleration",
     "pressure": "a pressure",
     "torque": "a torque",
+    "viscosity": "a dynamic viscosity",
+    "film_thickness": "a film thickness",
 }
 
 

@@ -55,7 +55,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 from clearance.checks import positive
-from clearance.lubrication import FilmModel
+from clearance.lubrication import FilmModel, Lubrication
 
 __all__ = [
     "FilmTerms",
@@ -66,6 +66,9 @@ __all__ = [
     "film_force",
     "film_torques",
     "minimum_film_thickness",
+    "FilmParameters",
+    "film_parameters",
+    "film_scalar",
 ]
 
 _PI = math.pi
@@ -337,3 +340,81 @@ def film_torques(
     if np.ndim(tj) == 0:
         return float(tj), float(tb)
     return tj, tb
+
+
+class FilmParameters(NamedTuple):
+    """A lubricated joint's film, prepared for `film_scalar` (SI).
+
+    Attributes:
+        film: the approximation.
+        scale: S [N s] (`film_scale`).
+        clearance: c [m].
+        ratio_max: ε_t = 1 − h_t/c, the clamp of the transition.
+        couette: 2π μ R³ L / c [N m s], the Couette torque per unit spin before 1/sqrt(1 − ε²).
+    """
+
+    film: FilmModel
+    scale: float
+    clearance: float
+    ratio_max: float
+    couette: float
+
+
+def film_parameters(
+    lubrication: Lubrication, *, journal_radius: float, bearing_length: float, clearance: float
+) -> FilmParameters:
+    """`FilmParameters` of a lubricated joint.
+
+    Args:
+        lubrication: the joint's oil film.
+        journal_radius: R [m] > 0.
+        bearing_length: L [m] > 0.
+        clearance: c [m] > 0, above the transition thickness.
+
+    Raises:
+        ValueError: a value out of range.
+    """
+    s = film_scale(
+        lubrication.film,
+        viscosity=lubrication.viscosity,
+        journal_radius=journal_radius,
+        bearing_length=bearing_length,
+        clearance=clearance,
+    )
+    c = float(clearance)
+    ratio_max = float(film_ratio(c, clearance=c, transition_thickness=lubrication.transition_thickness))
+    couette = 2.0 * _PI * lubrication.viscosity * journal_radius**3 * bearing_length / c
+    return FilmParameters(lubrication.film, s, c, ratio_max, couette)
+
+
+def film_scalar(
+    p: FilmParameters, ex: float, ey: float, vx: float, vy: float, spin: float
+) -> tuple[float, float, float, float]:
+    """Film force and torques at one state in plain floats (the operation order of a port).
+
+    The same quantities as `film_force` and `film_torques`, for one joint; the reference
+    solver evaluates it at every right-hand side.
+
+    Args:
+        p: the joint's `FilmParameters`.
+        ex, ey: e [m] in a frame fixed to the bearing (or any frame, with vx, vy alike).
+        vx, vy: ė [m/s], e's rate seen from the bearing, in the same axes.
+        spin: ω [rad/s], the journal's angular velocity relative to the bearing.
+
+    Returns:
+        (F_x, F_y, T_J, T_B): the force on the journal [N] in the axes of e, and the shear
+        torques on journal and bearing [N m].
+    """
+    d = math.hypot(ex, ey)
+    nx, ny = (ex / d, ey / d) if d > 0.0 else (1.0, 0.0)
+    tx, ty = -ny, nx
+    vn, vt = nx * vx + ny * vy, tx * vx + ty * vy
+    ratio = min(d / p.clearance, p.ratio_max)
+    k = film_terms(p.film, ratio)
+    c = p.clearance
+    fn = -p.scale * (k.a_r * spin + (k.b_r * vn - k.b_t * vt) / c)
+    ft = p.scale * (k.a_t * spin + (k.b_t * vn - k.g_t * vt) / c)
+    fx, fy = fn * nx + ft * tx, fn * ny + ft * ty
+    couette = p.couette * spin / math.sqrt(1.0 - ratio * ratio)
+    moment = ex * fy - ey * fx
+    return fx, fy, -couette - 0.5 * moment, couette - 0.5 * moment

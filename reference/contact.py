@@ -10,16 +10,21 @@ With e the journal centre minus the bearing centre (world frame), d = |e| and n 
     bearing gets -F at its contact point (Lankarani and Nikravesh 1990, Ambrósio 2002: docs/references.md).
 
 F_N follows the joint's `ContactLaw` with the approach speed delta_dot^- recorded at contact
-onset; F_T is Ambrosio's friction. The formulas are evaluated here in plain floats for speed
-and are tested against `clearance.contact_calibration.laws`, which is the definition.
+onset; F_T is Ambrosio's friction. A lubricated joint adds its oil film's force
+(`clearance.contact_calibration.film.film_scalar`, at every state whatever the contact mode)
+at the journal centre, minus it at the bearing centre, with the film's shear torques. The
+formulas are evaluated here in plain floats for speed and are tested against
+`clearance.contact_calibration.laws`, which is the definition.
 """
 
 from __future__ import annotations
 
+import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
+from clearance.contact_calibration.film import FilmParameters, film_parameters, film_scalar
 from clearance.contact_calibration.laws import bearing_stiffness, hysteresis_factor
 from clearance.model import Clearance, ContactLaw, Joint
 
@@ -218,19 +223,39 @@ def evaluate_contact(cj: ContactJoint, zl: Sequence[float], zdl: Sequence[float]
     ex, ey, edx, edy = px - qx, py - qy, vx - ux, vy - uy
     d = math.hypot(ex, ey)
     delta = d - cj.c
-    if d == 0.0:
-        return ex, ey, edx, edy, delta, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    nx, ny = ex / d, ey / d
-    ddot = nx * edx + ny * edy
-    # tangential relative velocity of the contact points along t = (-ny, nx)
-    vt = -ny * edx + nx * edy + wj * cj.rj - wb * cj.rb
-    if vin <= 0.0 or delta <= 0.0:
-        return ex, ey, edx, edy, delta, ddot, vt, 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
-    fn = normal_force_scalar(cj, delta, ddot, vin)
-    ft = friction_scalar(cj, fn, vt)
-    fx, fy = -fn * nx - ft * ny, -fn * ny + ft * nx
-    rjx, rjy = ajx + cj.rj * nx, ajy + cj.rj * ny
-    rbx, rby = abx + cj.rb * nx, aby + cj.rb * ny
-    mj = rjx * fy - rjy * fx
-    mb = -(rbx * fy - rby * fx)
+    ddot = vt = fx = fy = mj = mb = fn = ft = 0.0
+    if d > 0.0:
+        nx, ny = ex / d, ey / d
+        ddot = nx * edx + ny * edy
+        # tangential relative velocity of the contact points along t = (-ny, nx)
+        vt = -ny * edx + nx * edy + wj * cj.rj - wb * cj.rb
+        if vin > 0.0 and delta > 0.0:
+            fn = normal_force_scalar(cj, delta, ddot, vin)
+            ft = friction_scalar(cj, fn, vt)
+            fx, fy = -fn * nx - ft * ny, -fn * ny + ft * nx
+            rjx, rjy = ajx + cj.rj * nx, ajy + cj.rj * ny
+            rbx, rby = abx + cj.rb * nx, aby + cj.rb * ny
+            mj = rjx * fy - rjy * fx
+            mb = -(rbx * fy - rby * fx)
+    film = _film(cj.clearance)
+    if film is not None:
+        # e's rate seen from the bearing: e' - w_B z x e; the spin relative to the bearing
+        gx, gy, tj, tb = film_scalar(film, ex, ey, edx + wb * ey, edy - wb * ex, wj - wb)
+        fx, fy = fx + gx, fy + gy
+        mj += ajx * gy - ajy * gx + tj
+        mb += -(abx * gy - aby * gx) + tb
     return ex, ey, edx, edy, delta, ddot, vt, fx, fy, mj, mb, fn, ft
+
+
+@functools.cache
+def _film(clearance: Clearance) -> FilmParameters | None:
+    """The film of a lubricated joint's clearance (None for a dry one), prepared once."""
+    lub = clearance.lubrication
+    if lub is None or clearance.bearing_length is None:
+        return None
+    return film_parameters(
+        lub,
+        journal_radius=clearance.journal_radius,
+        bearing_length=clearance.bearing_length,
+        clearance=clearance.radial_clearance,
+    )

@@ -318,7 +318,7 @@ class ReferenceSystem:
         for cj, v in zip(self.contacts, vin):
             r = evaluate_contact(cj, zl, zdl, v)
             cres.append(r)
-            if r[11] != 0.0:
+            if r[11] != 0.0 or r[7] != 0.0 or r[8] != 0.0 or r[9] != 0.0:  # dry contact, or an oil film
                 if not math.isfinite(r[11]):  # a rejected trial stage far outside the physics
                     nan = np.full(self.nq, math.nan)
                     return Evaluation(

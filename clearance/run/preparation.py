@@ -104,6 +104,28 @@ def _cycle_times(mechanism: Mechanism, n: int = 181) -> np.ndarray:
     return np.linspace(0.0, mechanism.drive_period or 1.0, n)
 
 
+def _refuse_lubricated(mechanism: Mechanism, mode: ContactMode) -> None:
+    """Refuse a lubricated joint, with the reason, in a mode that cannot carry its film.
+
+    Raises:
+        ValueError: a clearance joint of the mechanism carries a `Lubrication`.
+    """
+    oiled = [j.name for j in mechanism.clearance_joints if j.require_clearance().lubrication is not None]
+    if not oiled:
+        return
+    if mode is ContactMode.EXACT:
+        why = "the compiled contact does not carry the film yet"
+    else:
+        why = (
+            f"contact mode '{mode.value}' (the ring of contact segments) cannot carry it: ring contacts push only "
+            "where a segment touches the journal, while the film pushes across the whole clearance from the "
+            "journal's speed"
+        )
+    raise ValueError(
+        f"joint(s) {oiled} are lubricated and {why}; run them with the reference solver (clearance reference)"
+    )
+
+
 def prepare(
     mechanism: Mechanism,
     options: ModelOptions | None = None,
@@ -129,6 +151,7 @@ def prepare(
     options = options or ModelOptions()
     cjoints = mechanism.clearance_joints
     exact = options.contact_mode is ContactMode.EXACT
+    _refuse_lubricated(mechanism, options.contact_mode)
     if exact and cjoints:
         require_plugin()  # before any work: without the compiled plugin this mode cannot run
     loads = joint_reactions(mechanism, _cycle_times(mechanism)) if cjoints else {}
