@@ -35,6 +35,7 @@ if TYPE_CHECKING:  # numpy is imported where it is used: `import clearance` stay
 
 __all__ = [
     "ContactLaw",
+    "CYLINDRICAL_LAWS",
     "JointType",
     "DriveKind",
     "OutputKind",
@@ -60,6 +61,32 @@ class ContactLaw(enum.Enum):
     GONTHIER = "gonthier"
     HU_GUO = "hu_guo"
     IMPACT = "impact"
+    # The cylindrical (conformal) laws of a pin in a hole (`contact_calibration.cylindrical_laws`;
+    # appended last: the compiled contact's law codes follow this order)
+    JOHNSON = "johnson"
+    RADZIMOVSKY = "radzimovsky"
+    GOLDSMITH = "goldsmith"
+    DUBOWSKY_FREUDENSTEIN = "dubowsky_freudenstein"
+    ESDU_78035 = "esdu_78035"
+    LIU = "liu"
+    PEREIRA = "pereira"
+    PERSSON = "persson"
+
+
+CYLINDRICAL_LAWS = frozenset(
+    (
+        ContactLaw.JOHNSON,
+        ContactLaw.RADZIMOVSKY,
+        ContactLaw.GOLDSMITH,
+        ContactLaw.DUBOWSKY_FREUDENSTEIN,
+        ContactLaw.ESDU_78035,
+        ContactLaw.LIU,
+        ContactLaw.PEREIRA,
+        ContactLaw.PERSSON,
+    )
+)
+"""The laws of a pin in a hole's line contact: they need the bearing length L
+(`Clearance.bearing_length`) and take Lankarani–Nikravesh's hysteresis damping."""
 
 
 class JointType(enum.Enum):
@@ -139,7 +166,9 @@ class Clearance:
         friction: Coulomb friction coefficient mu >= 0.
         law: normal contact force law.
         bearing_length: axial length L of the bearing [m], > 0, or None where nothing
-            needs it (a lubricated joint does).
+            needs it (a lubricated joint does). The cylindrical laws (`CYLINDRICAL_LAWS`)
+            take None as L = 2 R_B, a bearing as long as its bore
+            (`contact_calibration.cylindrical_laws.bearing_length`).
         lubrication: the oil film of a lubricated joint (`clearance.lubrication`), or None
             for a dry joint.
     """

@@ -2,13 +2,14 @@
 
 The same radial impact is run in the one-bearing MuJoCo scene (`scene_impact.impact_scene`:
 the joint's geoms, segment count, time step and small impedance) and in the point-mass
-reference (`impact.law_impact` with the clearance's law, K = `laws.bearing_stiffness`, cₑ
-and the effective mass), over a range of impact speeds and a couple of directions. The
-per-row stiffness k [N/m], damping b [N s/m] (emitted as direct-mode solref
-``(-k Â, -b Â)``) and impedance rise ε (emitted as solimp ``(d(1 − ε), d, c, 0.5, 1)``: the
-row impedance rises linearly with the row's penetration r from d(1 − ε) at r = 0 to d at
-r = c, the radial clearance; `clearance.mjcf.contact.row_solimp`) minimise, with
-`scipy.optimize.least_squares`, the residuals
+reference (`impact.clearance_impact` with the clearance's law, K = `laws.bearing_stiffness`
+or a cylindrical law's geometry and length, cₑ and the effective mass), over a range of
+impact speeds and a couple of directions. The per-row stiffness k [N/m], damping b [N s/m]
+(emitted as direct-mode solref ``(-k Â, -b Â)``) and impedance rise ε (emitted as solimp
+``(d(1 − ε), d, c, 0.5, 1)``: the row impedance rises linearly with the row's penetration
+r from d(1 − ε) at r = 0 to d at r = c, the radial clearance;
+`clearance.mjcf.contact.row_solimp`) minimise, with `scipy.optimize.least_squares`, the
+residuals
 
     (F̂/F_LN − 1)/0.05, (δ̂/δ_LN − 1)/0.05, (T̂/T_LN − 1)/0.10, (ê − e_LN)/0.02
 
@@ -44,7 +45,6 @@ from typing import TYPE_CHECKING
 import mujoco
 import numpy as np
 
-from clearance.contact_calibration.laws import bearing_stiffness
 from clearance.contact_calibration.nominal import nominal_parameters
 from clearance.contact_calibration.scene_impact import (
     DEFAULT_DIRECTIONS,
@@ -232,24 +232,20 @@ def default_speeds(impact_speed: float, n: int = 8) -> np.ndarray:
 
 
 def reference_impacts(clearance: Clearance, *, mass: float, speeds: np.ndarray) -> list[ImpactResult]:
-    """LN (or the clearance's law) point-mass impacts at each speed, K = bearing stiffness.
+    """Point-mass impacts under the clearance's law at each speed (`impact.clearance_impact`:
+    K = bearing stiffness for the point laws, the joint's geometry and length for the
+    cylindrical ones).
 
     Raises:
         ValueError: for the IMPACT law (it needs c_max and d_max, not a restitution).
     """
     # here, not at import: the impact reference needs scipy.integrate (0.3 s to import), and a
     # run whose calibration is cached reads this module without fitting
-    from clearance.contact_calibration.impact import law_impact
+    from clearance.contact_calibration.impact import clearance_impact
 
     if clearance.law is ContactLaw.IMPACT:
         raise ValueError("calibration against the IMPACT law is not supported (no c_max/d_max in Clearance)")
-    k = bearing_stiffness(clearance)
-    return [
-        law_impact(
-            clearance.law, mass=mass, speed=float(v), stiffness=k, restitution=clearance.restitution, n_samples=400
-        )
-        for v in speeds
-    ]
+    return [clearance_impact(clearance, mass=mass, speed=float(v), n_samples=400) for v in speeds]
 
 
 def _nstep(refs: list[ImpactResult], h: float) -> int:

@@ -53,7 +53,8 @@ from scipy.special import beta
 
 from clearance.checks import positive
 from clearance.contact_calibration import laws
-from clearance.model import Clearance, ContactLaw
+from clearance.contact_calibration.cylindrical_laws import CylinderLaw, cylinder_law, damped_force, elastic_energy
+from clearance.model import CYLINDRICAL_LAWS, Clearance, ContactLaw
 
 __all__ = [
     "ImpactResult",
@@ -62,6 +63,7 @@ __all__ = [
     "simulate_impact",
     "simulate_oblique_impact",
     "law_impact",
+    "cylinder_impact",
     "clearance_impact",
     "SolverOptions",
     "LawOptions",
@@ -548,19 +550,70 @@ def law_impact(
     return simulate_impact(force, mass=mass, speed=speed, **kw)
 
 
-def clearance_impact(clearance: Clearance, *, mass: float, speed: float, **kw: Unpack[LawOptions]) -> ImpactResult:
-    """`law_impact` with K = `laws.bearing_stiffness` and the clearance's law and cₑ.
+def cylinder_impact(
+    cyl: CylinderLaw, *, restitution: float, mass: float, speed: float, **kw: Unpack[SolverOptions]
+) -> ImpactResult:
+    """`simulate_impact` under a cylindrical law with LN hysteresis (`cylindrical_laws.damped_force`).
 
     Args:
-        clearance: the clearance joint (radii, materials, law, restitution).
+        cyl: the law (`cylindrical_laws.cylinder_law`).
+        restitution: cₑ [-] in [0, 1].
         mass: m [kg], > 0.
         speed: approach speed v [m/s], > 0.
-        **kw: ``exponent``, ``c_max``, ``d_max`` of `law_impact` and the solver options of
-            `simulate_impact`.
+        **kw: the solver options of `simulate_impact`.
 
     Returns:
         The simulated impact.
+
+    Raises:
+        ValueError: an argument out of range, or an impact whose kinetic energy exceeds the
+            elastic energy the law stores up to its deepest penetration δ* (it would reach δ*).
     """
+    chi = laws.hysteresis_factor(cyl.law, restitution)
+    m = positive("mass", mass, "kg")
+    v = positive("speed", speed, "m/s")
+    capacity = elastic_energy(cyl, cyl.max_penetration)
+    if 0.5 * m * v * v >= capacity:
+        raise ValueError(
+            f"an impact of {m:g} kg at {v:g} m/s ({0.5 * m * v * v:.3g} J) would reach the '{cyl.law.value}' law's "
+            f"deepest penetration {cyl.max_penetration:.3g} m (it stores {capacity:.3g} J there)"
+        )
+
+    def force(d: Any, dd: Any, vin: float) -> Any:
+        if np.ndim(d) == 0 and np.ndim(dd) == 0:
+            return damped_force(cyl, chi, float(d), float(dd), vin)
+        b = np.broadcast(d, dd)
+        return np.array([damped_force(cyl, chi, float(x), float(y), vin) for x, y in b]).reshape(b.shape)
+
+    return simulate_impact(force, mass=m, speed=v, **kw)
+
+
+def clearance_impact(clearance: Clearance, *, mass: float, speed: float, **kw: Unpack[LawOptions]) -> ImpactResult:
+    """The impact under a joint's law and cₑ: `law_impact` with K = `laws.bearing_stiffness`,
+    or for a cylindrical law `cylinder_impact` with its radii, materials and bearing length.
+
+    Args:
+        clearance: the clearance joint (radii, materials, law, restitution, bearing length).
+        mass: m [kg], > 0.
+        speed: approach speed v [m/s], > 0.
+        **kw: ``exponent``, ``c_max``, ``d_max`` of `law_impact` (not for a cylindrical law)
+            and the solver options of `simulate_impact`.
+
+    Returns:
+        The simulated impact.
+
+    Raises:
+        ValueError: as `law_impact` or `cylinder_impact`; ``exponent``, ``c_max`` or
+            ``d_max`` with a cylindrical law.
+    """
+    if clearance.law in CYLINDRICAL_LAWS:
+        extra = sorted(k for k in ("exponent", "c_max", "d_max") if k in kw)
+        if extra:
+            raise ValueError(f"{extra} do not apply to the cylindrical law '{clearance.law.value}'")
+        opts: SolverOptions = {k: v for k, v in kw.items() if k not in ("exponent", "c_max", "d_max")}  # type: ignore[assignment]
+        return cylinder_impact(
+            cylinder_law(clearance), restitution=clearance.restitution, mass=mass, speed=speed, **opts
+        )
     return law_impact(
         clearance.law,
         mass=mass,

@@ -30,7 +30,7 @@ import numpy as np
 from numpy.typing import ArrayLike
 
 from clearance.checks import positive
-from clearance.model import Clearance, ContactLaw, Material
+from clearance.model import CYLINDRICAL_LAWS, Clearance, ContactLaw, Material
 
 __all__ = [
     "contact_omega",
@@ -457,13 +457,16 @@ _FACTORS = {
     ContactLaw.GONTHIER: (False, lambda e: (1.0 - e * e) / e),
     ContactLaw.HU_GUO: (False, lambda e: 3.0 * (1.0 - e) / (2.0 * e)),
 }
+# the cylindrical laws take LN's hysteresis (`cylindrical_laws`)
+_FACTORS.update(dict.fromkeys(CYLINDRICAL_LAWS, _FACTORS[ContactLaw.LANKARANI_NIKRAVESH]))
 
 
 def hysteresis_factor(law: ContactLaw, restitution: float) -> float:
     """The factor χ(cₑ) of F = K δⁿ [1 + χ δ̇/δ̇⁻] (docs/references.md).
 
     LN 3(1 − cₑ²)/4; Hunt–Crossley 3(1 − cₑ)/2; Flores 8(1 − cₑ)/(5cₑ); Gonthier
-    (1 − cₑ²)/cₑ; Hu–Guo 3(1 − cₑ)/(2cₑ) (recalled, unverified); Hertz 0.
+    (1 − cₑ²)/cₑ; Hu–Guo 3(1 − cₑ)/(2cₑ) (recalled, unverified); Hertz 0; the cylindrical
+    laws (`cylindrical_laws`) LN's.
 
     Args:
         law: the contact law.
@@ -522,12 +525,18 @@ def normal_force(
         Normal force [N] >= 0, broadcast shape of the inputs (float for scalars).
 
     Raises:
-        ValueError: on an unknown law, IMPACT without c_max/d_max, or bad arguments.
+        ValueError: on an unknown law, a cylindrical law (`cylindrical_laws` gives those),
+            IMPACT without c_max/d_max, or bad arguments.
     """
     if not isinstance(law, ContactLaw):
         raise ValueError(f"law must be a ContactLaw (got {law!r})")
     if law is ContactLaw.HERTZ:
         return hertz(delta, stiffness=stiffness, exponent=exponent)
+    if law in CYLINDRICAL_LAWS:
+        raise ValueError(
+            f"the {law.value} law is a cylindrical law: its force needs the joint's radii, materials and "
+            "bearing length, not a stiffness; use contact_calibration.cylindrical_laws.cylindrical_force"
+        )
     if law is ContactLaw.IMPACT:
         c, d = _impact_params(c_max, d_max)
         return impact_law(delta, delta_dot, stiffness=stiffness, exponent=exponent, c_max=c, d_max=d)

@@ -4,7 +4,9 @@ Stiffness: the per-row stiffness k that makes the ring of N linear rows reproduc
 journal-bearing stiffness K of the clearance-joint literature (docs/references.md: K = 4/(3(sigma_B + sigma_J))
 sqrt(R_B R_J / (R_B - R_J))), k = K / C with C the ring coefficient of
 `clearance.mjcf.bearing.ring_stiffness_coefficient` (docs/mujoco_notes.md: a ring of linear
-rows is already Hertz-like, F ~ delta^1.5).
+rows is already Hertz-like, F ~ delta^1.5). For a cylindrical law K is the Hertz-like
+stiffness F_el(delta_ref)/delta_ref^1.5 that gives the law's force at the law impact's peak
+penetration delta_ref.
 
 Damping: the constant per-row damping b for which a radial impact of the ring model at a
 nominal speed (4 m/s by default) has the same restitution as the LN impact at that speed.
@@ -26,7 +28,7 @@ from clearance.mjcf.bearing import (
     ring_damping_coefficient,
     ring_stiffness_coefficient,
 )
-from clearance.model import Clearance, ContactLaw
+from clearance.model import CYLINDRICAL_LAWS, Clearance, ContactLaw
 from clearance.options import ContactParameters
 
 if TYPE_CHECKING:
@@ -85,17 +87,18 @@ def nominal_parameters(
     """
     from scipy.optimize import brentq  # here, not at import (see ring_impact)
 
-    from clearance.contact_calibration.impact import law_impact
+    from clearance.contact_calibration.cylindrical_laws import cylinder_law, elastic
+    from clearance.contact_calibration.impact import clearance_impact
 
     K = bearing_stiffness(clearance)
     ln = (
-        law_impact(
-            clearance.law, mass=effective_mass, speed=impact_speed, stiffness=K, restitution=clearance.restitution
-        )
+        clearance_impact(clearance, mass=effective_mass, speed=impact_speed)
         if clearance.law is not ContactLaw.IMPACT
         else None
     )
     delta_ref = ln.max_penetration if ln is not None else (5 * effective_mass * impact_speed**2 / (4 * K)) ** 0.4
+    if clearance.law in CYLINDRICAL_LAWS:
+        K = elastic(cylinder_law(clearance), delta_ref) / delta_ref**1.5
     c_k = ring_stiffness_coefficient(geom, (delta_ref / 20, delta_ref * 2))
     k = K / c_k
     target = ln.restitution if ln is not None else clearance.restitution

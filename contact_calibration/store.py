@@ -30,6 +30,7 @@ from typing import Any, Protocol
 import mujoco
 import numpy as np
 
+from clearance.contact_calibration.cylindrical_laws import bearing_length
 from clearance.contact_calibration.fit import (
     FIT_VERSION,
     CalibrationResult,
@@ -39,7 +40,7 @@ from clearance.contact_calibration.fit import (
     valid_mass_range,
 )
 from clearance.mjcf.bearing import RingGeometry
-from clearance.model import Clearance, Joint
+from clearance.model import CYLINDRICAL_LAWS, Clearance, Joint
 from clearance.options import ContactParameters, ModelOptions
 from clearance.results import atomic_write_bytes
 
@@ -132,7 +133,9 @@ def calibration_key(
         The key.
     """
     mat = lambda m: [float(m.youngs_modulus), float(m.poisson_ratio)]  # noqa: E731
-    return {
+    # the bearing length enters a cylindrical law's force only: other keys (and files) stay as they were
+    length = {"bearing_length": bearing_length(clearance)} if clearance.law in CYLINDRICAL_LAWS else {}
+    return length | {
         "bearing_radius": float(clearance.bearing_radius),
         "radial_clearance": float(clearance.radial_clearance),
         "bearing_material": mat(clearance.bearing_material),

@@ -38,6 +38,8 @@ from clearance.contact_plugin import PLUGIN_NAME, require
 from clearance.model import Clearance, ContactLaw
 
 __all__ = [
+    "COMPILED_LAWS",
+    "require_compiled_law",
     "SENSOR_FIELDS",
     "STATE_FIELDS",
     "add_for_clearance",
@@ -74,6 +76,19 @@ STATE_FIELDS: tuple[str, ...] = (
 """Names of one instance's first values in ``mjData.plugin_state``, in order; ``nv`` more follow
 (`state_size`)."""
 
+COMPILED_LAWS: tuple[ContactLaw, ...] = (
+    ContactLaw.HERTZ,
+    ContactLaw.LANKARANI_NIKRAVESH,
+    ContactLaw.HUNT_CROSSLEY,
+    ContactLaw.FLORES,
+    ContactLaw.GONTHIER,
+    ContactLaw.HU_GUO,
+    ContactLaw.IMPACT,
+)
+"""The laws the compiled contact knows (``kLawNames`` of clearance_contact.c, codes 0..6 in
+`ContactLaw` order); a port of a law adds it here. Any other law is refused before anything
+is compiled (`require_compiled_law`)."""
+
 _DISSIPATIVE = (
     ContactLaw.LANKARANI_NIKRAVESH,
     ContactLaw.HUNT_CROSSLEY,
@@ -81,6 +96,24 @@ _DISSIPATIVE = (
     ContactLaw.GONTHIER,
     ContactLaw.HU_GUO,
 )
+
+
+def require_compiled_law(law: ContactLaw, joint: str) -> None:
+    """Refuse a law the compiled contact does not know yet, in one line naming the joint.
+
+    Args:
+        law: the joint's law.
+        joint: the joint (or contact) name, for the message.
+
+    Raises:
+        ValueError: ``law`` is not in `COMPILED_LAWS`.
+    """
+    if law not in COMPILED_LAWS:
+        raise ValueError(
+            f"joint '{joint}': law '{law.value}' is not in the compiled exact contact yet (it knows "
+            f"{', '.join(m.value for m in COMPILED_LAWS)}); run it with contact_mode 'nominal' or 'calibrated', "
+            "or in the reference solver"
+        )
 
 
 def _number(joint: str, attribute: str, value: Any, expected: str, ok: Any) -> float:
@@ -178,6 +211,7 @@ def add_journal_bearing(
             f"journal-bearing contact '{j}': law must be a ContactLaw member (got {law!r}); "
             f"expected one of {', '.join(m.name for m in ContactLaw)}"
         )
+    require_compiled_law(law, j)
     config = {
         "journal_site": journal_site,
         "bearing_site": bearing_site,

@@ -24,9 +24,10 @@ import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 
+from clearance.contact_calibration.cylindrical_laws import CylinderLaw, cylinder_law, damped_force
 from clearance.contact_calibration.film import FilmParameters, film_parameters, film_scalar
 from clearance.contact_calibration.laws import bearing_stiffness, hysteresis_factor
-from clearance.model import Clearance, ContactLaw, Joint
+from clearance.model import CYLINDRICAL_LAWS, Clearance, ContactLaw, Joint
 
 __all__ = ["ContactJoint", "contact_joints", "normal_force_scalar", "friction_scalar"]
 
@@ -51,6 +52,8 @@ class ContactJoint:
         chi: hysteresis factor of the law [-].
         mu, v0, v1: friction coefficient and Ambrosio thresholds [m/s].
         c_max, d_max: IMPACT damping [N s/m] and full-damping depth [m] (0 if unused).
+        cylinder: a cylindrical law's constants (`cylindrical_laws.cylinder_law`, its force
+            with ``chi``), or None: the force is ``kind``'s from ``stiffness``, ``exponent``.
     """
 
     name: str
@@ -73,6 +76,7 @@ class ContactJoint:
     v1: float
     c_max: float
     d_max: float
+    cylinder: CylinderLaw | None = None
 
 
 def contact_joints(
@@ -146,6 +150,7 @@ def contact_joints(
                 v1=float(v1),
                 c_max=cm,
                 d_max=dm,
+                cylinder=cylinder_law(cl) if cl.law in CYLINDRICAL_LAWS else None,
             )
         )
     return out
@@ -230,7 +235,10 @@ def evaluate_contact(cj: ContactJoint, zl: Sequence[float], zdl: Sequence[float]
         # tangential relative velocity of the contact points along t = (-ny, nx)
         vt = -ny * edx + nx * edy + wj * cj.rj - wb * cj.rb
         if vin > 0.0 and delta > 0.0:
-            fn = normal_force_scalar(cj, delta, ddot, vin)
+            if cj.cylinder is None:
+                fn = normal_force_scalar(cj, delta, ddot, vin)
+            else:
+                fn = damped_force(cj.cylinder, cj.chi, delta, ddot, vin)
             ft = friction_scalar(cj, fn, vt)
             fx, fy = -fn * nx - ft * ny, -fn * ny + ft * nx
             rjx, rjy = ajx + cj.rj * nx, ajy + cj.rj * ny

@@ -26,6 +26,7 @@ from typing import NamedTuple, TypedDict, Unpack
 import numpy as np
 from scipy.linalg.lapack import dposv
 
+from clearance.contact_calibration.cylindrical_laws import elastic_energy
 from clearance.contact_calibration.laws import MIN_APPROACH_SPEED
 from clearance.kinematics import assemble, velocities
 from clearance.model import Drive, DriveKind, Joint, Link, Mechanism, MotionLaw
@@ -418,7 +419,8 @@ class ReferenceSystem:
         """Kinetic, elastic contact and gravity potential energy [J], shape (...,) each.
 
         The contact potential is that of the elastic part K delta^(n+1) / (n+1) of each
-        joint in penetration (exact for Hertz and LN with c_e = 1).
+        joint in penetration (exact for Hertz and LN with c_e = 1), or a cylindrical law's
+        `cylindrical_laws.elastic_energy`.
         """
         z, zd = np.asarray(z, dtype=float), np.asarray(zd, dtype=float)
         kin = 0.5 * np.sum(self.mass * zd * zd, axis=-1)
@@ -431,6 +433,10 @@ class ReferenceSystem:
             delta = np.array([evaluate_contact(cj, zi, zi, 0.0)[4] for zi in z.reshape(-1, self.nq).tolist()]).reshape(
                 z.shape[:-1]
             )
+            if isinstance(cj, ContactJoint) and cj.cylinder is not None:
+                cyl = cj.cylinder
+                pot += np.vectorize(lambda d, cyl=cyl: elastic_energy(cyl, d), otypes=[float])(delta)
+                continue
             n = cj.exponent
             pot += cj.stiffness * np.maximum(delta, 0.0) ** (n + 1) / (n + 1)
         return kin, pot, grav

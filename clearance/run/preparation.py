@@ -23,7 +23,7 @@ from clearance.contact_calibration.effective_mass import cycle_effective_mass
 from clearance.contact_calibration.laws import bearing_stiffness, contact_omega
 from clearance.contact_plugin import PLUGIN_NAME, is_available
 from clearance.contact_plugin import require as require_plugin
-from clearance.contact_plugin.attributes import add_for_clearance
+from clearance.contact_plugin.attributes import add_for_clearance, require_compiled_law
 from clearance.contact_plugin.energy import add_energy_meter
 from clearance.loads import joint_reactions
 from clearance.mjcf import (
@@ -154,6 +154,8 @@ def prepare(
     _refuse_lubricated(mechanism, options.contact_mode)
     if exact and cjoints:
         require_plugin()  # before any work: without the compiled plugin this mode cannot run
+        for j in cjoints:
+            require_compiled_law(j.require_clearance().law, j.name)
     loads = joint_reactions(mechanism, _cycle_times(mechanism)) if cjoints else {}
     segs: dict[str, int] = {}
     pre: dict[str, tuple[float, float, float, float]] = {}
