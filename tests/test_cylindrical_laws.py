@@ -241,3 +241,36 @@ def test_exact_contact_refuses_a_law_the_compiled_library_does_not_know(law: Con
     assert law not in attributes.COMPILED_LAWS  # until the compiled port adds it
     with pytest.raises(ValueError, match=rf"joint 'pin': law '{law.value}' is not in the compiled exact contact yet"):
         attributes.require_compiled_law(law, "pin")
+
+
+def test_a_run_in_exact_mode_refuses_the_law_before_any_work() -> None:
+    from clearance import ModelOptions, simulate
+    from clearance.builders import slider_crank
+
+    mech = slider_crank(law=ContactLaw.JOHNSON, bearing_length=0.02)
+    with pytest.raises(
+        ValueError, match=r"^joint 'rod_slider': law 'johnson' is not in the compiled exact contact yet"
+    ):
+        simulate(mech, duration=1e-4, options=ModelOptions(contact_mode="exact"))
+
+
+def test_retrofit_play_takes_the_bearing_length() -> None:
+    from clearance.cli import build_parser
+    from clearance.cli.retrofit import plays_from_args
+    from clearance.retrofit import RadialPlay
+
+    play = RadialPlay.make(1e-4, law=ContactLaw.RADZIMOVSKY, bearing_length=0.012)
+    assert bearing_length(play.clearance) == 0.012
+    args = build_parser().parse_args(
+        [
+            "retrofit",
+            "m.xml",
+            "--out",
+            "x",
+            "--law",
+            "johnson",
+            "--joint",
+            "elbow:clearance_mm=0.2,bearing_length_mm=12",
+        ]
+    )
+    assert plays_from_args(args)["elbow"].clearance.bearing_length == pytest.approx(0.012, rel=1e-15)

@@ -50,11 +50,13 @@ JOINT_KEYS = {
     "friction": "--friction",
     "eccentricity_x_mm": "",
     "eccentricity_y_mm": "",
+    "bearing_length_mm": "",
     "backlash_arcmin": "",
     "mesh_stiffness": "",
 }
 """Per-joint keys of ``--joint NAME:key=value,...`` -> the option they override ('': none; the
-journal's start in its bearing frame, [mm], defaults to the centre; ``backlash_arcmin`` gives
+journal's start in its bearing frame, [mm], defaults to the centre; ``bearing_length_mm``, the
+bearing's length L a cylindrical law uses, defaults to the bore 2 R_B; ``backlash_arcmin`` gives
 the hinge gear backlash of that half-width instead of radial play, with its stop's
 ``mesh_stiffness`` [N m/rad] and ``restitution``)."""
 
@@ -248,6 +250,8 @@ def plays_from_args(args: argparse.Namespace) -> dict[str, RadialPlay]:
                 f"{where}: the radial clearance {v['clearance_mm']:g} mm must be smaller than the bearing radius "
                 f"{v['bearing_radius_mm']:g} mm (--clearance-mm, --bearing-radius-mm)"
             )
+        if v["bearing_length_mm"] < 0:
+            raise ValueError(f"{where}: bearing_length_mm must be > 0 (got {v['bearing_length_mm']:g})")
         ecc = math.hypot(v["eccentricity_x_mm"], v["eccentricity_y_mm"])
         if ecc >= v["clearance_mm"]:
             raise ValueError(
@@ -263,6 +267,7 @@ def plays_from_args(args: argparse.Namespace) -> dict[str, RadialPlay]:
             restitution=v["restitution"],
             friction=v["friction"],
             law=ContactLaw(args.law),
+            bearing_length=si(v["bearing_length_mm"], "mm") if v["bearing_length_mm"] else None,
         )
         check_clearance(where, clearance, f"--joint {text}")
         eccentricity = (si(v["eccentricity_x_mm"], "mm"), si(v["eccentricity_y_mm"], "mm"))

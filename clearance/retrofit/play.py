@@ -104,9 +104,11 @@ class RadialPlay:
         restitution: float = 0.9,
         friction: float = 0.0,
         law: ContactLaw = ContactLaw.LANKARANI_NIKRAVESH,
+        bearing_length: float | None = None,
         initial_eccentricity: tuple[float, float] = (0.0, 0.0),
     ) -> RadialPlay:
-        """A play from its numbers (SI units); raises `ValueError` naming a bad one."""
+        """A play from its numbers (SI units; ``bearing_length`` None: the bore, 2 R_B, for a
+        cylindrical law); raises `ValueError` naming a bad one."""
         c = Clearance(
             radial_clearance,
             bearing_radius,
@@ -115,6 +117,7 @@ class RadialPlay:
             restitution=restitution,
             friction=friction,
             law=law,
+            bearing_length=bearing_length,
         )
         return cls(c, initial_eccentricity)
 
