@@ -1,7 +1,7 @@
 """Build of the optional compiled contact plugin (all other metadata is in pyproject.toml).
 
-The MuJoCo engine plugin `clearance.journal_bearing` (contact_plugin/clearance_contact.c) is a
-plain C shared library, not a Python extension module: MuJoCo loads it with
+The MuJoCo engine plugins of `clearance` (contact_plugin/*.c, registered in clearance_contact.c)
+form a plain C shared library, not a Python extension module: MuJoCo loads it with
 ``mujoco.mj_loadPluginLibrary``. It is compiled against the headers of the mujoco wheel found
 in the build environment (``build-system.requires`` pins ``mujoco==4.0.*``) and linked against
 that wheel's ``libmujoco.so.<version>`` by full path, with no rpath: the dynamic loader records
@@ -83,7 +83,14 @@ setup(
     ext_modules=[
         Extension(
             "clearance.contact_plugin._journal_bearing",
-            sources=["contact_plugin/clearance_contact.c"],
+            sources=[
+                "contact_plugin/clearance_contact.c",
+                "contact_plugin/plugin_util.c",
+                "contact_plugin/contact_laws.c",
+                "contact_plugin/journal_bearing.c",
+                "contact_plugin/work_meter.c",
+                "contact_plugin/backlash_stop.c",
+            ],
             extra_compile_args=["-O2", "-std=c99"],
             optional=True,
         )

@@ -1,7 +1,7 @@
 """clearance.contact_plugin: exact journal–bearing contact computed inside MuJoCo.
 
 `clearance.journal_bearing` is a MuJoCo engine plugin written in C
-(``contact_plugin/clearance_contact.c``, whose header comment is the full specification). One
+(``contact_plugin/journal_bearing.c``, whose header comment is the full specification). One
 plugin instance per clearance joint computes, from two sites and two radii, the exact
 circle-in-circle penetration, a normal force from any `clearance.model.ContactLaw` (the
 formulas of `clearance.contact_calibration.laws`, reproduced operation by operation) and

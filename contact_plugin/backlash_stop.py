@@ -5,7 +5,7 @@ same axis with the gear mesh's impact law, `clearance.contact_calibration.laws.m
 (angular Lankarani–Nikravesh, T = K δⁿ [1 + 3(1 − cₑ²)/4 · δ̇/δ̇⁻], δ = |q_load − q_motor| − b),
 evaluated in C operation by operation and applied as passive torques (−s T on the load, +s T
 on the motor, s the side of the band). The approach speed δ̇⁻ of each impact is kept in the
-plugin's state; the C file's section on this plugin is the full specification.
+plugin's state; contact_plugin/backlash_stop.c's header is the full specification.
 
 Every attribute is validated here, in Python, before anything is compiled (as
 `clearance.contact_plugin.attributes` does for the journal bearing).

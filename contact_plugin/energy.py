@@ -2,7 +2,7 @@
 
 MuJoCo measures the kinetic energy (½ v'Mv, armature included) and the potential energy
 (gravity and springs) with its own sensors, but has no sensor for the work of the forces
-that change them. The `clearance.work` engine plugin (``contact_plugin/clearance_contact.c``,
+that change them. The `clearance.work` engine plugin (``contact_plugin/work_meter.c``,
 whose comment is its specification) integrates, once per step, the work done on the model by
 each kind of force: actuators, equality constraint rows (``connect`` loop closures), contact
 constraint rows (the ring bearings), other constraint rows (limits, friction loss), MuJoCo's

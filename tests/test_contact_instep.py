@@ -1,4 +1,4 @@
-"""The compiled contact's in-step treatment (the C file's "In-step treatment", "Friction near rest").
+"""The compiled contact's in-step treatment (journal_bearing.c: "In-step treatment", "Friction near rest").
 
 The treatment is checked against its formula computed the slow, obvious way (Jacobians and M⁻¹
 from MuJoCo in Python), then on what it is for: a mechanism whose penetration rate has a large

@@ -222,7 +222,7 @@ def test_exact_start_in_contact_matches_the_reference_solver(side, timestep):
     # At the floor the law's damping chi K delta^1.5 / MIN_APPROACH_SPEED = 3e5 N s/m on the
     # 0.14 kg the journal meets along the guide: h w C = 6.4 at 3 us. The explicit damping held
     # that contact at 0.1 us and lost it at 0.25 us; integrated exponentially over the step (the
-    # C file's "In-step treatment") it holds at the default step as at 0.1 us.
+    # journal_bearing.c's "In-step treatment") it holds at the default step as at 0.1 us.
     mech = slider_crank()
     c, d0 = 0.5e-3, 10e-6
     start = (side * (c + d0), 0.0)
