@@ -372,7 +372,7 @@ def damped_force(cyl: CylinderLaw, chi: float, delta: float, delta_dot: float, a
     f = elastic_force(cyl, delta)
     if f == 0.0:
         return 0.0
-    f *= 1.0 + chi * delta_dot / approach_speed
+    f *= 1.0 + chi * (delta_dot / approach_speed)  # the operations of laws._dissipative
     return f if f > 0.0 else 0.0
 
 
@@ -436,7 +436,7 @@ def cylindrical_force(
         raise ValueError(f"approach_speed must be positive and finite everywhere (got {approach_speed!r} m/s)")
     chi = hysteresis_factor(cyl.law, restitution)
     el = np.asarray(elastic(cyl, delta), dtype=float)
-    return _out(np.maximum(el * (1.0 + chi * np.asarray(delta_dot, dtype=float) / v), 0.0))
+    return _out(np.maximum(el * (1.0 + chi * (np.asarray(delta_dot, dtype=float) / v)), 0.0))
 
 
 def penetration(cyl: CylinderLaw, force: ArrayLike) -> Force:
