@@ -1,13 +1,15 @@
 """The keywords that end every catalogue builder's signature, declared once.
 
 After its own dimensions and drives, every builder takes where its clearances are
-(``clearance_at``), their contact properties (``radial_clearance``, ``bearing_radius``,
-``restitution``, ``friction``, ``law``, ``material``), ``gravity`` and the mechanism's
-``name``. `ContactKeywords` declares them for the type checker (a builder ends with
-``**contact: Unpack[ContactKeywords]``); `contact_keywords` gives a builder their defaults
-and writes them into its signature one by one, so that `inspect.signature` (the command
-line, scenario files) and ``help`` list every keyword and an unknown one raises TypeError;
-`ClearanceFactory` turns them into `Clearance` records.
+(``clearance_at``: revolute joints, and the prismatic joints of its sliders), their contact
+properties (``radial_clearance``, ``bearing_radius``, ``restitution``, ``friction``, ``law``,
+``material``; a slider's block ``slider_length`` by ``slider_height`` and its corners'
+``guide_stiffness``), ``gravity`` and the mechanism's ``name``. `ContactKeywords` declares
+them for the type checker (a builder ends with ``**contact: Unpack[ContactKeywords]``);
+`contact_keywords` gives a builder their defaults and writes them into its signature one by
+one, so that `inspect.signature` (the command line, scenario files) and ``help`` list every
+keyword and an unknown one raises TypeError; `ClearanceFactory` turns them into `Clearance`
+and `TranslationalClearance` records.
 """
 
 from __future__ import annotations
@@ -27,6 +29,7 @@ from clearance.model import (
     Material,
     Mechanism,
 )
+from clearance.translational import DEFAULT_GUIDE_STIFFNESS, TranslationalClearance
 
 __all__ = [
     "DEFAULT_RADIAL_CLEARANCE",
@@ -45,9 +48,11 @@ class ContactKeywords(TypedDict, total=False):
     """The keywords every catalogue builder takes after its own dimensions and drives.
 
     Attributes:
-        clearance_at: joints with clearance (any of the builder's clearable joints); empty
-            for the ideal mechanism.
-        radial_clearance: c [m] at every clearance joint.
+        clearance_at: joints with clearance (any of the builder's clearable joints: revolute
+            joints get a radial clearance, a slider's prismatic joint a translational one);
+            empty for the ideal mechanism.
+        radial_clearance: c [m] at every clearance joint (a slider: the gap on each side of
+            its block in the guide).
         bearing_radius: R_B [m].
         restitution: coefficient of restitution of every clearance joint.
         friction: Coulomb friction coefficient of every clearance joint.
@@ -58,6 +63,12 @@ class ContactKeywords(TypedDict, total=False):
         bearing_length: axial length L [m] of every clearance joint's bearing, or None.
         lubrication: the oil film of every clearance joint (`Lubrication`), or None for
             dry joints; needs ``bearing_length``.
+        slider_length: length [m] of a slider's block along its guide (translational
+            clearance only).
+        slider_height: height [m] of a slider's block across its guide (translational
+            clearance only).
+        guide_stiffness: K [N/m^1.5] of a slider's corners against its guide (translational
+            clearance only).
     """
 
     clearance_at: Sequence[str]
@@ -71,6 +82,9 @@ class ContactKeywords(TypedDict, total=False):
     name: str
     bearing_length: float | None
     lubrication: Lubrication | None
+    slider_length: float
+    slider_height: float
+    guide_stiffness: float
 
 
 CONTACT_DEFAULTS: ContactKeywords = {
@@ -83,8 +97,13 @@ CONTACT_DEFAULTS: ContactKeywords = {
     "gravity": 0.0,
     "bearing_length": None,
     "lubrication": None,
+    "slider_length": 0.040,
+    "slider_height": 0.020,
+    "guide_stiffness": DEFAULT_GUIDE_STIFFNESS,
 }
-"""The catalogue's defaults of the contact keywords; ``clearance_at`` and ``name`` are each builder's own."""
+"""The catalogue's defaults of the contact keywords; ``clearance_at`` and ``name`` are each builder's own.
+
+The catalogue's sliders are the project's own 40 mm by 20 mm blocks (the papers give none)."""
 
 _Builder = TypeVar("_Builder", bound=Callable[..., Mechanism])
 
@@ -153,22 +172,23 @@ class ClearanceFactory:
     """The contact keywords of one builder call: `Clearance` records by joint name, gravity, name.
 
     Args:
-        clearable: joints that may carry a clearance (the others are driven or prismatic).
+        clearable: revolute joints that may carry a clearance (the others are driven).
         contact: the call's contact keywords, every one present (as a builder decorated
             with `contact_keywords` receives them).
+        sliders: prismatic joints whose slider may have play in its guide.
 
     Raises:
         ValueError: an unknown or non-clearable joint in ``clearance_at``, or a bad value.
     """
 
-    def __init__(self, clearable: Sequence[str], contact: ContactKeywords) -> None:
+    def __init__(self, clearable: Sequence[str], contact: ContactKeywords, *, sliders: Sequence[str] = ()) -> None:
         clearance_at, law, material = contact["clearance_at"], contact["law"], contact["material"]
         if isinstance(clearance_at, str):
             raise ValueError(f"clearance_at must be a sequence of joint names (got the string {clearance_at!r})")
         self.joints = tuple(clearance_at)
-        unknown = [j for j in self.joints if j not in clearable]
+        unknown = [j for j in self.joints if j not in (*clearable, *sliders)]
         if unknown:
-            raise ValueError(f"clearance_at: unknown joint(s) {unknown}; expected any of {list(clearable)}")
+            raise ValueError(f"clearance_at: unknown joint(s) {unknown}; expected any of {[*clearable, *sliders]}")
         if not isinstance(law, ContactLaw):
             raise ValueError(f"law must be a ContactLaw (got {law!r})")
         if not isinstance(material, Material):
@@ -184,6 +204,19 @@ class ClearanceFactory:
             bearing_length=contact["bearing_length"],
             lubrication=contact["lubrication"],
         )
+        self.slider: TranslationalClearance | None = None
+        """The translational clearance of the sliders in ``clearance_at`` (None if there are none)."""
+        if any(j in sliders for j in self.joints):
+            self.slider = TranslationalClearance(
+                clearance=contact["radial_clearance"],
+                slider_length=contact["slider_length"],
+                slider_height=contact["slider_height"],
+                stiffness=contact["guide_stiffness"],
+                restitution=contact["restitution"],
+                friction=contact["friction"],
+                law=law,
+            )
+        self.slider_keywords = {k: contact[k] for k in ("slider_length", "slider_height", "guide_stiffness")}
         self.gravity = contact["gravity"]
         self.name = contact["name"]
 
@@ -195,12 +228,22 @@ class ClearanceFactory:
         """A revolute joint, with clearance when ``name`` is in ``clearance_at``."""
         return Joint(name, JointType.REVOLUTE, link_a, point_a, link_b, point_b, clearance=self(name))
 
+    def prismatic(
+        self, name: str, link_a: str, point_a: str, link_b: str, point_b: str, *, axis: tuple[float, float]
+    ) -> Joint:
+        """A prismatic joint (guide ``link_a``, slider ``link_b``), with play when ``name`` is in ``clearance_at``."""
+        play = self.slider if name in self.joints else None
+        return Joint(
+            name, JointType.PRISMATIC, link_a, point_a, link_b, point_b, axis=axis, translational_clearance=play
+        )
+
     def pin(self, name: str, link_a: str, link_b: str) -> Joint:
         """A revolute joint between points named ``name`` of both links, with clearance as `revolute`."""
         return self.revolute(name, link_a, name, link_b, name)
 
     def parameters(self) -> dict[str, Any]:
-        """The contact keywords but ``name`` as JSON-friendly builder parameters."""
+        """The contact keywords but ``name`` as JSON-friendly builder parameters (the slider keywords
+        only where a slider has play)."""
         c = self.template
         extra: dict[str, Any] = {}
         if c.bearing_length is not None:
@@ -218,6 +261,8 @@ class ClearanceFactory:
                 "youngs_modulus": c.bearing_material.youngs_modulus,
                 "poisson_ratio": c.bearing_material.poisson_ratio,
             },
+            # a slider's block and stiffness, where a slider has play
+            **({k: float(v) for k, v in self.slider_keywords.items()} if self.slider else {}),
             "gravity": float(self.gravity),
             **extra,
         }

@@ -69,6 +69,8 @@ class LinkageInfo:
             revolute joint but the driven crank's and the output link's ground pivots.
         transmission: where the transmission angles are measured.
         provenance: where the dimensions come from.
+        sliders: prismatic joints whose slider may have play in its guide (a translational
+            clearance; `clearance_at` may name them besides ``clearable``).
     """
 
     topology: str
@@ -78,6 +80,7 @@ class LinkageInfo:
     criticality: tuple[str, ...]
     transmission: tuple[TransmissionAngle, ...]
     provenance: str
+    sliders: tuple[str, ...] = ()
 
 
 def positive(name: str, value: float, unit: str = "m") -> float:

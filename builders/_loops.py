@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from clearance.builders._contact import ClearanceFactory
 from clearance.builders._linkage import Point, angle_of, circle_circle, frame_point, line_circle, polar
-from clearance.model import Joint, JointType
+from clearance.model import Joint
 
 __all__ = [
     "crank_rocker",
@@ -91,5 +91,5 @@ def slider_crank_joints(clr: ClearanceFactory) -> tuple[Joint, ...]:
         clr.pin("O2", "ground", "crank2"),
         clr.pin("A", "crank2", "rod3"),
         clr.pin("B", "rod3", "slider4"),
-        Joint("P4", JointType.PRISMATIC, "ground", "G4", "slider4", "B", axis=(1.0, 0.0)),
+        clr.prismatic("P4", "ground", "G4", "slider4", "B", axis=(1.0, 0.0)),
     )

@@ -31,15 +31,17 @@ RANGES: dict[str, tuple[float, float]] = {
     "torque": (0.0, 1e7),
     "viscosity": (1e-6, 1e4),
     "film_thickness": (1e-9, 1e-2),
+    "contact_stiffness": (1e3, 1e16),
 }
 """Quantity -> (smallest, largest) magnitude [SI] of a scenario number other than 0.
 
 Lengths from 1 µm to 1 km, masses from 1 mg to 1000 t, drive speeds from 0.01 rpm to
 `clearance.checks.MAX_DRIVE_RPM`, Young's moduli from 1 kPa (a gel) to 10 TPa (beyond
 diamond); angles and accelerations up to 10^4 (rad, m/s^2); oil viscosities from 1 uPa s (a
-gas) to 10 kPa s (a bitumen); film thicknesses from 1 nm to 1 cm. 0 is left to the mechanism's own
-checks (a ground link has no mass). A coordinate pair (a point, a pivot, a centre of mass)
-is held to the largest magnitude only: a coordinate may be 0 or tiny.
+gas) to 10 kPa s (a bitumen); film thicknesses from 1 nm to 1 cm; contact stiffnesses from 1e3 to
+1e16 N/m^1.5. 0 is left to the mechanism's own checks (a ground link has no mass). A
+coordinate pair (a point, a pivot, a centre of mass) is held to the largest magnitude only: a
+coordinate may be 0 or tiny.
 """
 
 

@@ -69,6 +69,7 @@ SLIDER_CRANK_INFO = LinkageInfo(
     clearable=("crank_rod", "rod_slider"),
     criticality=("crank_rod", "rod_slider"),
     transmission=(TransmissionAngle("rod_slider", ("rod", "big_end"), guide="slider_guide"),),
+    sliders=("slider_guide",),
     provenance="the benchmark of Flores and Ambrósio 2004 (docs/references.md; crank and rod checked, "
     "masses and inertias recalled)",
 )

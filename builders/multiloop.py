@@ -44,7 +44,7 @@ from clearance.builders._linkage import (
 from clearance.builders._loops import coupler_bars, coupler_point, crank_rocker, crank_rocker_joints
 from clearance.builders.slider_crank import rpm
 from clearance.kinematics import TransmissionAngle as _T
-from clearance.model import Joint, JointType, Link, Mechanism, Output, OutputKind
+from clearance.model import Joint, Link, Mechanism, Output, OutputKind
 
 __all__ = ["eight_bar", "ten_bar", "EIGHT_BAR_INFO", "TEN_BAR_INFO"]
 
@@ -56,6 +56,7 @@ EIGHT_BAR_INFO = LinkageInfo(
     "slider 8 (F, horizontal guide; output: its x).",
     driven=("O2",),
     output_pivot="P8",
+    sliders=("P8",),
     clearable=("A", "B", "O4", "C", "D", "O6", "E", "F"),
     criticality=("A", "B", "O4", "C", "D", "O6", "E", "F"),
     transmission=(
@@ -71,6 +72,7 @@ TEN_BAR_INFO = LinkageInfo(
     "(D-G), ternary link 8 (F, G, H), rod 9 (H-I), slider 10 (I, horizontal guide; output: its x).",
     driven=("O2",),
     output_pivot="P10",
+    sliders=("P10",),
     clearable=("A", "B", "O4", "C", "E", "O6", "D", "G", "F", "H", "I"),
     criticality=("A", "B", "O4", "C", "E", "O6", "D", "G", "F", "H", "I"),
     transmission=(
@@ -131,7 +133,7 @@ def _open(
     """
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(info.clearable, contact)
+    clr = ClearanceFactory(info.clearable, contact, sliders=info.sliders)
     cp = (float(coupler3_point[0]), float(coupler3_point[1]))
     p = crank_rocker(
         dims["crank_length"], dims["coupler3_length"], dims["rocker4_length"], dims["ground_length"], start_angle
@@ -280,7 +282,7 @@ def eight_bar(
         clr.pin("O6", "ground", "rocker6"),
         clr.pin("E", "rocker6", "rod7"),
         clr.pin("F", "rod7", "slider8"),
-        Joint("P8", JointType.PRISMATIC, "ground", "G8", "slider8", "F", axis=(1.0, 0.0)),
+        clr.prismatic("P8", "ground", "G8", "slider8", "F", axis=(1.0, 0.0)),
     )
     own = {"rocker6_pivot": list(o6), "rocker6_arm_angle": float(rocker6_arm_angle)}
     return _close(o, links, joints, own, guide_height, "slider8", "F", crank_speed, start_angle)
@@ -390,7 +392,7 @@ def ten_bar(
         clr.pin("F", "rocker6", "link8"),
         clr.pin("H", "link8", "rod9"),
         clr.pin("I", "rod9", "slider10"),
-        Joint("P10", JointType.PRISMATIC, "ground", "G10", "slider10", "I", axis=(1.0, 0.0)),
+        clr.prismatic("P10", "ground", "G10", "slider10", "I", axis=(1.0, 0.0)),
     )
     own = {
         "rocker4_arm_angle": float(rocker4_arm_angle),

@@ -40,8 +40,6 @@ from clearance.kinematics import TransmissionAngle
 from clearance.model import (
     Drive,
     DriveKind,
-    Joint,
-    JointType,
     Link,
     Mechanism,
     MotionLaw,
@@ -60,6 +58,7 @@ PRESS_INFO = LinkageInfo(
     "rod 5 (C-D), slider 6 (D; output: its y). Seed clearances: A and C.",
     driven=("O2", "O7"),
     output_pivot="P6",
+    sliders=("P6",),
     clearable=("A", "B", "E", "C", "D"),
     criticality=("A", "B", "E", "C", "D"),
     transmission=(
@@ -151,7 +150,7 @@ def seven_bar_press(
     )
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(PRESS_INFO.clearable, contact)
+    clr = ClearanceFactory(PRESS_INFO.clearable, contact, sliders=PRESS_INFO.sliders)
     drive2 = _drive("crank2", "O2", crank2_speed, crank2_motion, crank2_start_angle)
     if crank7_speed is None:
         crank7_speed = crank2_motion.speed if crank2_motion is not None else crank2_speed
@@ -181,7 +180,7 @@ def seven_bar_press(
         clr.pin("O7", "ground", "crank7"),
         clr.pin("C", "plate4", "rod5"),
         clr.pin("D", "rod5", "slider6"),
-        Joint("P6", JointType.PRISMATIC, "ground", "G6", "slider6", "D", axis=(0.0, 1.0)),
+        clr.prismatic("P6", "ground", "G6", "slider6", "D", axis=(0.0, 1.0)),
     )
     dims.update(
         plate4_point=[u, v],

@@ -13,8 +13,10 @@ optional ``[mechanism.parameters]``), ``[[links]]`` (name, mass_kg, inertia_kg_m
 position_guess_m, angle_guess_rad, ``points_m``), ``[[joints]]`` (name, kind, link_a,
 point_a, link_b, point_b, axis, optional ``[joints.clearance]`` with radial_clearance_mm,
 bearing_radius_mm, journal_link, restitution, friction, law, materials, bearing_length_mm and a
-``[joints.clearance.lubrication]`` table for an oiled joint), ``[[drives]]``
-(name, joint, kind, speed_rpm, start_angle_deg, torque_n_m, optional ``[drives.motion]``)
+``[joints.clearance.lubrication]`` table for an oiled joint; a prismatic joint's optional
+``[joints.translational_clearance]``, see `clearance.builders._translational_toml`),
+``[[drives]]`` (name, joint, kind, speed_rpm, start_angle_deg, torque_n_m,
+initial_speed_rad_per_s of a torque drive, optional ``[drives.motion]``)
 and ``[[outputs]]`` (name, link, kind, point). Units are part of the key names; any
 length, angle or speed unit of `clearance.units.UNITS` may be used. Files are
 validated before a `Mechanism` is built; errors name the file, line, table and key. A
@@ -38,6 +40,7 @@ import tomli_w
 from clearance.builders._contact import lubrication_document
 from clearance.builders._scenario_builder import from_builder, read_lubrication
 from clearance.builders._toml_reader import Locator, ScenarioError, Table
+from clearance.builders._translational_toml import read_translational, translational_document
 from clearance.kinematics import AssemblyError, SingularPositionError, assemble
 from clearance.model import (
     Clearance,
@@ -287,8 +290,14 @@ def _joint(t: Table, links: dict[str, Link]) -> Joint:
                 "lubrication",
             ]
         )
-    t.finish(["name", "kind", "link_a", "point_a", "link_b", "point_b", "axis", "clearance"])
-    return _wrap(t, None, lambda: Joint(name, kind, la, pa, lb, pb, axis=axis, clearance=clearance))
+    tt = t.sub("translational_clearance", "translational_clearance")
+    play = None if tt is None else read_translational(tt)
+    t.finish(["name", "kind", "link_a", "point_a", "link_b", "point_b", "axis", "clearance", "translational_clearance"])
+    return _wrap(
+        t,
+        None,
+        lambda: Joint(name, kind, la, pa, lb, pb, axis=axis, clearance=clearance, translational_clearance=play),
+    )
 
 
 def _drive(t: Table, joints: set[str]) -> Drive:
@@ -310,10 +319,20 @@ def _drive(t: Table, joints: set[str]) -> Drive:
             start_angle=t.number("start_angle", "angle", 0.0),
             motion=motion,
             torque=t.number("torque", "torque", 0.0),
+            initial_speed=t.number("initial_speed", "angular_speed", 0.0),
         ),
     )
     t.finish(
-        ["name", "joint", "kind", "speed_<rad_per_s|rpm|deg_per_s>", "start_angle_<rad|deg>", "torque_n_m", "motion"]
+        [
+            "name",
+            "joint",
+            "kind",
+            "speed_<rad_per_s|rpm|deg_per_s>",
+            "start_angle_<rad|deg>",
+            "torque_n_m",
+            "initial_speed_<rad_per_s|rpm|deg_per_s>",
+            "motion",
+        ]
     )
     return drive
 
@@ -364,6 +383,8 @@ def scenario_document(mechanism: Mechanism) -> dict[str, Any]:
         }
         if j.kind is JointType.PRISMATIC:
             d["axis"] = list(j.axis)
+        if j.translational_clearance is not None:
+            d["translational_clearance"] = translational_document(j.translational_clearance)
         c = j.clearance
         if c is not None:
             d["clearance"] = {
@@ -391,6 +412,8 @@ def scenario_document(mechanism: Mechanism) -> dict[str, Any]:
             "start_angle_rad": dr.start_angle,
             "torque_n_m": dr.torque,
         }
+        if dr.initial_speed:
+            d["initial_speed_rad_per_s"] = dr.initial_speed
         if dr.motion is not None:
             d["motion"] = {"speed_rad_per_s": dr.motion.speed, "harmonics_rad": [list(h) for h in dr.motion.harmonics]}
             if dr.motion.period is not None:

@@ -29,9 +29,10 @@ from clearance.units import UNITS
 __all__ = ["slider_crank", "SLIDER_CRANK_JOINTS", "rpm"]
 
 SLIDER_CRANK_JOINTS = ("crank_pivot", "crank_rod", "rod_slider", "slider_guide")
-"""Joint names; clearance may be put at ``crank_rod`` and/or ``rod_slider``."""
+"""Joint names; clearance may be put at ``crank_rod``, ``rod_slider`` (radial) and ``slider_guide`` (translational)."""
 
 _CLEARABLE = ("crank_rod", "rod_slider")
+_SLIDERS = ("slider_guide",)
 
 
 def rpm(value: float) -> float:
@@ -52,6 +53,7 @@ def slider_crank(
     slider_inertia: float = 1.0e-4,
     crank_speed: float = rpm(5000.0),
     start_angle: float = 0.0,
+    free_crank: bool = False,
     **contact: Unpack[ContactKeywords],
 ) -> Mechanism:
     """Build the in-line slider-crank with clearance at the chosen revolute joints.
@@ -65,12 +67,17 @@ def slider_crank(
         crank_mass, rod_mass, slider_mass: masses [kg].
         crank_inertia, rod_inertia, slider_inertia: moments of inertia about the centre of
             mass [kg m^2].
-        crank_speed: constant crank speed [rad/s] (default 5000 rpm; see `rpm`).
+        crank_speed: constant crank speed [rad/s] (default 5000 rpm; see `rpm`); with
+            ``free_crank`` the crank's speed at t = 0.
         start_angle: crank angle at t = 0 [rad] (0: crank along +x, slider at top dead
             centre).
+        free_crank: no drive: the crank turns freely from ``crank_speed`` at t = 0 (a torque
+            drive of 0 N m; Flores, Leine and Glocker 2010).
         clearance_at, radial_clearance, bearing_radius, restitution, friction, law,
-            material, gravity, name: the contact keywords (`ContactKeywords`);
-            ``clearance_at`` any of ``crank_rod`` and ``rod_slider``; ``radial_clearance``
+            material, slider_length, slider_height, guide_stiffness, gravity, name: the
+            contact keywords (`ContactKeywords`); ``clearance_at`` any of ``crank_rod``,
+            ``rod_slider`` and ``slider_guide`` (the slider's play in its guide, a block of
+            ``slider_length`` by ``slider_height`` centred on its pin); ``radial_clearance``
             0.5 mm by default.
 
     Returns:
@@ -80,7 +87,9 @@ def slider_crank(
         ValueError: a value out of range, an unknown clearance joint, or a rod too short to
             close the loop.
     """
-    clr = ClearanceFactory(_CLEARABLE, contact)
+    clr = ClearanceFactory(_CLEARABLE, contact, sliders=_SLIDERS)
+    if not isinstance(free_crank, bool):
+        raise ValueError(f"free_crank must be true or false (got {free_crank!r})")
     positive("crank_length", crank_length, "m")
     positive("rod_length", rod_length, "m")
     if rod_length <= crank_length:
@@ -124,9 +133,13 @@ def slider_crank(
         Joint("crank_pivot", JointType.REVOLUTE, "ground", "crank_pivot", "crank", "pivot"),
         clr.revolute("crank_rod", "crank", "pin", "rod", "big_end"),
         clr.revolute("rod_slider", "rod", "small_end", "slider", "pin"),
-        Joint("slider_guide", JointType.PRISMATIC, "ground", "guide", "slider", "pin", axis=(1.0, 0.0)),
+        clr.prismatic("slider_guide", "ground", "guide", "slider", "pin", axis=(1.0, 0.0)),
     )
-    drives = (Drive("crank", "crank_pivot", DriveKind.CONSTANT_SPEED, speed=crank_speed, start_angle=th),)
+    if free_crank:
+        drive = Drive("crank", "crank_pivot", DriveKind.TORQUE, initial_speed=crank_speed, start_angle=th)
+    else:
+        drive = Drive("crank", "crank_pivot", DriveKind.CONSTANT_SPEED, speed=crank_speed, start_angle=th)
+    drives = (drive,)
     outputs = (Output("slider_x", "slider", OutputKind.POSITION_X, point="pin"),)
     params = {
         "crank_length": r,
@@ -139,6 +152,7 @@ def slider_crank(
         "slider_inertia": slider_inertia,
         "crank_speed": crank_speed,
         "start_angle": th,
+        **({"free_crank": True} if free_crank else {}),
         **clr.parameters(),
     }
     return Mechanism(

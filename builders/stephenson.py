@@ -89,6 +89,7 @@ STEPHENSON_I_SLIDER_INFO = LinkageInfo(
     "link 5 (E-G), link 6 (G-F).",
     driven=("O2",),
     output_pivot="P4",
+    sliders=("P4",),
     clearable=("A", "B", "E", "G", "F"),
     criticality=("A", "B", "E", "G", "F"),
     transmission=(_T("B", ("rod3", "A"), guide="P4"), _T("G", ("link5", "E"), follower=("link6", "F"))),
@@ -251,7 +252,7 @@ def stephenson_i_slider(
     )
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(STEPHENSON_I_SLIDER_INFO.clearable, contact)
+    clr = ClearanceFactory(STEPHENSON_I_SLIDER_INFO.clearable, contact, sliders=STEPHENSON_I_SLIDER_INFO.sliders)
     off = (float(slider_pin_offset[0]), float(slider_pin_offset[1]))
     p = slider_crank_loop(crank_length, rod3_length, start_angle, pin="F", offset=off)
     o2, pa, pb, pf = p["O2"], p["A"], p["B"], p["F"]

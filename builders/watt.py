@@ -36,7 +36,7 @@ from clearance.builders._linkage import (
 from clearance.builders._loops import crank_rocker, crank_rocker_joints, slider_crank_joints, slider_crank_loop
 from clearance.builders.slider_crank import rpm
 from clearance.kinematics import TransmissionAngle
-from clearance.model import Joint, JointType, Link, Mechanism, Output, OutputKind
+from clearance.model import Joint, Link, Mechanism, Output, OutputKind
 
 __all__ = [
     "watt_six_bar",
@@ -71,6 +71,7 @@ WATT_SLIDER_1_INFO = LinkageInfo(
     ),
     driven=("O2",),
     output_pivot="P6",
+    sliders=("P6",),
     clearable=("A", "B", "O4", "C", "D"),
     criticality=("A", "B", "O4", "C", "D"),
     transmission=(_T_B, TransmissionAngle("D", ("rod5", "C"), guide="P6")),
@@ -85,6 +86,7 @@ WATT_SLIDER_2_INFO = LinkageInfo(
     ),
     driven=("O2",),
     output_pivot="O6",
+    sliders=("P4",),
     clearable=("A", "B", "C", "D", "O6"),
     criticality=("A", "B", "C", "D"),
     transmission=(
@@ -248,7 +250,7 @@ def watt_six_bar_slider_1(
     e, f = positive("rocker4_arm", rocker4_arm), positive("rod5_length", rod5_length)
     ms, js = positive("slider_mass", slider_mass, "kg"), positive("slider_inertia", slider_inertia, "kg m^2")
     lam = positive("linear_density", linear_density, "kg/m")
-    clr = ClearanceFactory(WATT_SLIDER_1_INFO.clearable, contact)
+    clr = ClearanceFactory(WATT_SLIDER_1_INFO.clearable, contact, sliders=WATT_SLIDER_1_INFO.sliders)
     loop1, p = _loop1(a, b, c, d, e, rocker4_arm_angle, start_angle, lam)
     g6 = (d + f, float(guide_height))
     pd = line_circle(g6, (1.0, 0.0), p["C"], f, forward=True, what="rod 5 / slider 6")
@@ -261,7 +263,7 @@ def watt_six_bar_slider_1(
     joints = (
         *_loop1_joints(clr, "rod5"),
         clr.pin("D", "rod5", "slider6"),
-        Joint("P6", JointType.PRISMATIC, "ground", "G6", "slider6", "D", axis=(1.0, 0.0)),
+        clr.prismatic("P6", "ground", "G6", "slider6", "D", axis=(1.0, 0.0)),
     )
     dims: dict[str, Any] = {
         "crank_length": a,
@@ -323,7 +325,7 @@ def watt_six_bar_slider_2(
     lam = positive("linear_density", linear_density, "kg/m")
     if b <= a:
         raise ValueError(f"rod3_length must be > crank_length = {a} m (got {b} m)")
-    clr = ClearanceFactory(WATT_SLIDER_2_INFO.clearable, contact)
+    clr = ClearanceFactory(WATT_SLIDER_2_INFO.clearable, contact, sliders=WATT_SLIDER_2_INFO.sliders)
     o6 = (float(rocker6_pivot[0]), float(rocker6_pivot[1]))
     off = (float(slider_pin_offset[0]), float(slider_pin_offset[1]))
     p = slider_crank_loop(a, b, start_angle, pin="C", offset=off)

@@ -54,19 +54,21 @@ class _Pair:
 
 
 class _Held:
-    """A torque drive seen by kinematics: its joint held at the start angle, at rest."""
+    """A torque drive seen by kinematics: its joint at the start angle turning at its initial speed."""
 
-    def __init__(self, name: str, angle: float) -> None:
+    def __init__(self, name: str, angle: float, speed: float = 0.0) -> None:
         self.name = name
         self.start_angle = angle
+        self.speed = speed
 
     def angle(self, t: ArrayLike) -> NDArray[np.float64]:
-        return self.start_angle + 0.0 * np.asarray(t, dtype=float)
+        return self.start_angle + self.speed * np.asarray(t, dtype=float)
 
     def rate(self, t: ArrayLike) -> NDArray[np.float64]:
-        return 0.0 * np.asarray(t, dtype=float)
+        return self.speed + 0.0 * np.asarray(t, dtype=float)
 
-    acceleration = rate
+    def acceleration(self, t: ArrayLike) -> NDArray[np.float64]:
+        return 0.0 * np.asarray(t, dtype=float)
 
 
 class ConstraintSystem:
@@ -78,12 +80,14 @@ class ConstraintSystem:
 
     Args:
         mechanism: the mechanism.
-        include_clearance: if True (default) clearance joints count as ideal revolute
-            joints; if False they are left out (their links are then held by contact).
+        include_clearance: if True (default) clearance joints count as ideal joints (a
+            radial clearance as a revolute, a slider with play as a prismatic); if False they
+            are left out (their links are then held by contact).
         include_drives: if True (default) each constant-speed or motion-law drive adds one
             rheonomic row theta_b - theta_a - angle(t) = 0, and each torque drive a row
-            holding its joint at the drive's start angle (so a torque-driven mechanism
-            assembles, at rest, in the pose its start angles give). The reference solver,
+            holding its joint at the drive's start angle, turning at its initial speed (so a
+            torque-driven mechanism assembles in the pose its start angles give, with the
+            velocities its initial speeds give). The reference solver,
             which applies torque drives as torques, builds its system without them.
     """
 
@@ -100,7 +104,7 @@ class ConstraintSystem:
         self.pairs: list[_Pair] = []
         self.pair_names: list[str] = []
         for j in mechanism.joints:
-            if j.clearance is not None and not include_clearance:
+            if j.has_play and not include_clearance:
                 continue
             pa = np.array(links[j.link_a].point(j.point_a))
             pb = np.array(links[j.link_b].point(j.point_b))
@@ -113,7 +117,7 @@ class ConstraintSystem:
         if include_drives:
             for d in mechanism.drives:
                 jt = mechanism.joint(d.joint)
-                law = _Held(d.name, d.start_angle) if d.kind is DriveKind.TORQUE else d
+                law = _Held(d.name, d.start_angle, d.initial_speed) if d.kind is DriveKind.TORQUE else d
                 self.drives.append((law, index[jt.link_a], index[jt.link_b]))
         self.n_constraints = 2 * len(self.pairs) + len(self.drives)
         self.length_scale = _length_scale(mechanism)

@@ -33,6 +33,8 @@ if TYPE_CHECKING:  # numpy is imported where it is used: `import clearance` stay
     import numpy as np
     from numpy.typing import ArrayLike, NDArray
 
+    from clearance.translational import TranslationalClearance
+
 __all__ = [
     "ContactLaw",
     "CYLINDRICAL_LAWS",
@@ -279,6 +281,8 @@ class Joint:
         link_b, point_b: second link and its point (for a prismatic joint: the slider).
         axis: prismatic sliding direction in the frame of link_a (normalised here).
         clearance: radial clearance of a revolute joint, or None for an ideal joint.
+        translational_clearance: play of a prismatic joint's slider in its guide
+            (`clearance.translational.TranslationalClearance`), or None for an ideal slider.
     """
 
     name: str
@@ -289,6 +293,7 @@ class Joint:
     point_b: str
     axis: tuple[float, float] = (1.0, 0.0)
     clearance: Clearance | None = None
+    translational_clearance: TranslationalClearance | None = None
 
     def __post_init__(self) -> None:
         _name("Joint.name", self.name)
@@ -316,6 +321,34 @@ class Joint:
                     f"joint '{self.name}' clearance journal_link must be '{self.link_a}' or "
                     f"'{self.link_b}' (got '{jl}')"
                 )
+        if self.translational_clearance is not None:
+            from clearance.translational import TranslationalClearance
+
+            if self.kind is not JointType.PRISMATIC:
+                raise ValueError(
+                    f"joint '{self.name}': translational_clearance is only supported on prismatic joints "
+                    f"(got kind={self.kind.value})"
+                )
+            if not isinstance(self.translational_clearance, TranslationalClearance):
+                raise ValueError(
+                    f"joint '{self.name}' translational_clearance must be a TranslationalClearance "
+                    f"(got {self.translational_clearance!r})"
+                )
+
+    @property
+    def has_play(self) -> bool:
+        """Whether the joint has a clearance of either kind (radial or translational)."""
+        return self.clearance is not None or self.translational_clearance is not None
+
+    def require_translational(self) -> TranslationalClearance:
+        """The joint's translational clearance, for code that handles sliders with play only.
+
+        Raises:
+            ValueError: the joint has no translational clearance.
+        """
+        if self.translational_clearance is None:
+            raise ValueError(f"joint '{self.name}' has no translational clearance")
+        return self.translational_clearance
 
     def require_clearance(self) -> Clearance:
         """The joint's clearance, for code that handles clearance joints only.
@@ -404,6 +437,8 @@ class Drive:
         start_angle: drive angle at t = 0 [rad].
         motion: the motion law (MOTION_LAW).
         torque: constant torque [N m] (TORQUE).
+        initial_speed: speed of the joint at t = 0 [rad/s] (TORQUE; a crank that turns
+            freely from a given speed is a torque drive of 0 N m with this speed).
     """
 
     name: str
@@ -413,6 +448,7 @@ class Drive:
     start_angle: float = 0.0
     motion: MotionLaw | None = None
     torque: float = 0.0
+    initial_speed: float = 0.0
 
     def __post_init__(self) -> None:
         _name("Drive.name", self.name)
@@ -422,6 +458,12 @@ class Drive:
         finite(f"drive '{self.name}' speed", self.speed)
         finite(f"drive '{self.name}' start_angle", self.start_angle)
         finite(f"drive '{self.name}' torque", self.torque)
+        finite(f"drive '{self.name}' initial_speed", self.initial_speed)
+        if self.initial_speed != 0 and self.kind is not DriveKind.TORQUE:
+            raise ValueError(
+                f"drive '{self.name}' initial_speed is for torque drives (a {self.kind.value} drive starts at "
+                f"its prescribed speed; got {self.initial_speed!r} rad/s)"
+            )
         if self.kind is DriveKind.CONSTANT_SPEED and self.speed == 0:
             raise ValueError(f"drive '{self.name}' speed must be non-zero for a constant-speed drive")
         if self.kind is DriveKind.MOTION_LAW and not isinstance(self.motion, MotionLaw):
@@ -672,13 +714,18 @@ class Mechanism:
 
     @property
     def clearance_joints(self) -> tuple[Joint, ...]:
-        """Joints that carry a clearance, in declaration order."""
+        """Revolute joints that carry a (radial) clearance, in declaration order."""
         return tuple(j for j in self.joints if j.clearance is not None)
 
+    @property
+    def translational_joints(self) -> tuple[Joint, ...]:
+        """Prismatic joints whose slider has play in its guide, in declaration order."""
+        return tuple(j for j in self.joints if j.translational_clearance is not None)
+
     def ideal_twin(self) -> Mechanism:
-        """The same mechanism with every clearance replaced by an ideal hinge."""
+        """The same mechanism with every clearance replaced by an ideal hinge or slider."""
         return dataclasses.replace(
             self,
             name=self.name if self.name.endswith("_ideal") else f"{self.name}_ideal",
-            joints=tuple(dataclasses.replace(j, clearance=None) for j in self.joints),
+            joints=tuple(dataclasses.replace(j, clearance=None, translational_clearance=None) for j in self.joints),
         )

@@ -35,6 +35,8 @@ from typing import Any
 
 import numpy as np
 
+from clearance.translational import SLIDER_FIELDS, SliderResult
+
 __all__ = [
     "ENERGY_TERMS",
     "JointResult",
@@ -241,6 +243,9 @@ class SimulationResult:
         body_poses: (n, n_bodies, 7) world position (x, y, z) [m] and orientation quaternion
             (w, x, y, z) of every body of a 3-D model (``metadata['bodies']`` names them, the
             world body first); empty (0 rows) for planar mechanisms, which use ``link_poses``.
+        sliders: prismatic joint with play name -> `clearance.translational.SliderResult`
+            (the slider's position and tilt in its guide, its corners' contact, the contact
+            case); empty for a run without translational clearance.
     """
 
     times: np.ndarray
@@ -255,6 +260,7 @@ class SimulationResult:
     energy: dict[str, np.ndarray] = field(default_factory=dict)
     joint_reactions: dict[str, np.ndarray] = field(default_factory=dict)
     body_poses: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 7)))
+    sliders: dict[str, SliderResult] = field(default_factory=dict)
 
     def __len__(self) -> int:
         return len(self.times)
@@ -288,6 +294,7 @@ class SimulationResult:
             energy={k: v[sl] for k, v in self.energy.items()},
             joint_reactions={k: v[sl] for k, v in self.joint_reactions.items()},
             body_poses=self.body_poses[sl] if len(self.body_poses) else self.body_poses,
+            sliders={k: v.sliced(sl) for k, v in self.sliders.items()},
         )
 
     def decimated(self, every: int) -> SimulationResult:
@@ -319,11 +326,16 @@ class SimulationResult:
             energy={k: cat([p.energy[k] for p in parts]) for k in first.energy},
             joint_reactions={k: cat([p.joint_reactions[k] for p in parts]) for k in first.joint_reactions},
             body_poses=cat([p.body_poses for p in parts]) if len(first.body_poses) else first.body_poses,
+            sliders={
+                k: SliderResult(*(cat([getattr(p.sliders[k], f) for p in parts]) for f in SLIDER_FIELDS))
+                for k in first.sliders
+            },
         )
 
     def arrays(self) -> dict[str, np.ndarray]:
         """Every series of the result by its name in the saved ``.npz`` (``times``,
-        ``output/<name>``, ``joint/<joint>/<field>``, ``energy/<term>``, ``reaction/<joint>``, ...)."""
+        ``output/<name>``, ``joint/<joint>/<field>``, ``energy/<term>``, ``reaction/<joint>``,
+        ``slider/<joint>/<field>``, ...)."""
         arrays: dict[str, np.ndarray] = {
             "times": self.times,
             "drive_angle": self.drive_angle,
@@ -343,6 +355,9 @@ class SimulationResult:
             arrays[f"reaction/{k}"] = v
         if len(self.body_poses):
             arrays["body_poses"] = self.body_poses
+        for j, sr in self.sliders.items():
+            for f in SLIDER_FIELDS:
+                arrays[f"slider/{j}/{f}"] = getattr(sr, f)
         return arrays
 
     # -- persistence --------------------------------------------------------------------
@@ -376,6 +391,7 @@ class SimulationResult:
             meta["energy_balance"] = self.energy_balance()
             meta["energy_names"] = list(self.energy)
         meta["reaction_names"] = list(self.joint_reactions)
+        meta["slider_names"] = list(self.sliders)
         atomic_write_bytes(npz, buf.getvalue())
         atomic_write_text(js, json.dumps(meta, indent=2, sort_keys=True, default=_json_default))
         return npz, js
@@ -389,6 +405,7 @@ class SimulationResult:
         joint_names = meta.pop("joint_names")
         energy_names = meta.pop("energy_names", [])  # absent in files saved before energy series existed
         reaction_names = meta.pop("reaction_names", [])  # absent in files saved before reactions existed
+        slider_names = meta.pop("slider_names", [])  # absent in files saved before sliders had play
         with np.load(stem.with_suffix(".npz"), allow_pickle=False) as z:
             return cls(
                 times=z["times"],
@@ -403,6 +420,7 @@ class SimulationResult:
                 energy={k: z[f"energy/{k}"] for k in energy_names},
                 joint_reactions={k: z[f"reaction/{k}"] for k in reaction_names},
                 body_poses=z["body_poses"] if "body_poses" in z.files else np.zeros((0, 0, 7)),
+                sliders={j: SliderResult(*(z[f"slider/{j}/{f}"] for f in SLIDER_FIELDS)) for j in slider_names},
             )
 
 

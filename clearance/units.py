@@ -29,6 +29,7 @@ UNITS: dict[str, dict[str, float]] = {
     "torque": {"n_m": 1.0},
     "viscosity": {"pa_s": 1.0, "mpa_s": 1e-3},
     "film_thickness": {"m": 1.0, "mm": 1e-3, "um": 1e-6, "nm": 1e-9},
+    "contact_stiffness": {"n_per_m1_5": 1.0},
 }
 """Quantity -> unit suffix -> factor to SI."""
 
@@ -48,6 +49,7 @@ _NAMES = {
     "torque": "a torque",
     "viscosity": "a dynamic viscosity",
     "film_thickness": "a film thickness",
+    "contact_stiffness": "a contact stiffness (force per penetration^1.5)",
 }
 
 
@@ -63,7 +65,7 @@ def quantity_of(param: str) -> str | None:
         return "angle"
     if param.endswith("_speed"):
         return "angular_speed"
-    if param in ("radial_clearance", "bearing_radius", "guide_height", "guide_x") or param.endswith(
+    if param in ("radial_clearance", "bearing_radius", "guide_height", "guide_x", "slider_height") or param.endswith(
         ("_length", "_arm", "_offset", "_point", "_pivot")
     ):
         return "length"
@@ -75,6 +77,8 @@ def quantity_of(param: str) -> str | None:
         return "linear_density"
     if param == "gravity":
         return "acceleration"
+    if param.endswith("_stiffness"):
+        return "contact_stiffness"
     return None
 
 

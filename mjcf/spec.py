@@ -41,7 +41,14 @@ from clearance.mjcf.tree import BodyTree, body_tree
 from clearance.model import DriveKind, Joint, JointType, Link, Mechanism, OutputKind
 from clearance.options import ContactMode, GeomType, ModelOptions
 
-__all__ = ["BuiltModel", "build_spec", "drive_armature", "drive_gear", "ring_geometry"]
+__all__ = [
+    "BuiltModel",
+    "build_spec",
+    "drive_armature",
+    "drive_gear",
+    "ring_geometry",
+    "refuse_translational_clearance",
+]
 
 _OBJ = mujoco.mjtObj
 _SENS = mujoco.mjtSensor
@@ -75,6 +82,19 @@ class BuiltModel:
     qd0: np.ndarray
     link_order: tuple[str, ...] = ()
     exact_contact: bool = False
+
+
+def refuse_translational_clearance(mechanism: Mechanism) -> None:
+    """Refuse a mechanism whose slider has play in its guide: MuJoCo does not model it yet.
+
+    Raises:
+        ValueError: naming the joint and where such a mechanism runs.
+    """
+    for j in mechanism.translational_joints:
+        raise ValueError(
+            f"joint '{j.name}' of '{mechanism.name}' has a translational clearance: translational clearance "
+            "runs in the reference solver only so far (use 'clearance reference')"
+        )
 
 
 def ring_geometry(joint: Joint, segments: int, options: ModelOptions) -> RingGeometry:
@@ -140,8 +160,10 @@ def build_spec(
 
     Raises:
         AssemblyError: the mechanism cannot be assembled at t = 0.
-        ValueError: a loop cannot be cut (see `body_tree`).
+        ValueError: a loop cannot be cut (see `body_tree`); a slider with play
+            (`refuse_translational_clearance`).
     """
+    refuse_translational_clearance(mechanism)
     tree = body_tree(mechanism)
     q0 = assemble(mechanism, 0.0)
     qd0 = velocities(mechanism, q0, 0.0)

@@ -1,4 +1,4 @@
-"""Holonomic constraints of the ideal joints and prescribed drives, in plain floats.
+"""Holonomic constraints of the ideal joints and prescribed drives, in plain floats (joints with play have none).
 
 The same constraints as `clearance.kinematics.ConstraintSystem` (and tested against it),
 written for the reference solver's right-hand side: centre-of-mass coordinates
@@ -83,7 +83,7 @@ class ConstraintRows:
         self.pairs: list[_Pair] = []
         self.pair_names: list[str] = []
         for j in joints:
-            if j.clearance is not None:
+            if j.has_play:
                 continue
             sa, sb = rel(j.link_a, j.point_a), rel(j.link_b, j.point_b)
             rev = j.kind is JointType.REVOLUTE

@@ -23,15 +23,83 @@ import functools
 import math
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Protocol
 
 from clearance.contact_calibration.cylindrical_laws import CylinderLaw, cylinder_law, damped_force
 from clearance.contact_calibration.film import FilmParameters, film_parameters, film_scalar
 from clearance.contact_calibration.laws import bearing_stiffness, hysteresis_factor
 from clearance.model import CYLINDRICAL_LAWS, Clearance, ContactLaw, Joint
 
-__all__ = ["ContactJoint", "contact_joints", "normal_force_scalar", "friction_scalar"]
+__all__ = [
+    "ContactJoint",
+    "LawPoint",
+    "contact_joints",
+    "law_terms",
+    "check_thresholds",
+    "normal_force_scalar",
+    "friction_scalar",
+]
 
 _HERTZ, _CHI, _IMPACT = 0, 1, 2
+
+
+class LawPoint(Protocol):
+    """What the scalar laws read of a contact: a clearance joint or a slider's corner (SI)."""
+
+    @property
+    def stiffness(self) -> float: ...  # K [N/m^n]
+    @property
+    def exponent(self) -> float: ...  # n [-]
+    @property
+    def kind(self) -> int: ...  # 0 Hertz, 1 K delta^n (1 + chi delta_dot / v-), 2 IMPACT
+    @property
+    def chi(self) -> float: ...  # hysteresis factor [-]
+    @property
+    def mu(self) -> float: ...  # friction coefficient [-]
+    @property
+    def v0(self) -> float: ...  # Ambrosio's no-friction speed [m/s]
+    @property
+    def v1(self) -> float: ...  # Ambrosio's full-friction speed [m/s]
+    @property
+    def c_max(self) -> float: ...  # IMPACT damping [N s/m]
+    @property
+    def d_max(self) -> float: ...  # IMPACT full-damping depth [m]
+
+
+def check_thresholds(v0: float, v1: float) -> None:
+    """Refuse Ambrosio thresholds unless 0 <= v0 < v1 [m/s] (both finite).
+
+    Raises:
+        ValueError: naming both values.
+    """
+    if not (math.isfinite(v0) and math.isfinite(v1) and 0 <= v0 < v1):
+        raise ValueError(f"friction thresholds must satisfy 0 <= v0 < v1 [m/s] (got {v0!r}, {v1!r})")
+
+
+def law_terms(
+    law: ContactLaw, restitution: float, joint: str, c_max: float | None, d_max: float | None
+) -> tuple[int, float, float, float]:
+    """(kind, chi, c_max, d_max) of a normal law as the scalar force evaluates it.
+
+    Args:
+        law: the joint's law.
+        restitution: its c_e.
+        joint: joint name (for the message).
+        c_max, d_max: IMPACT parameters [N s/m, m], required for IMPACT only.
+
+    Raises:
+        ValueError: an IMPACT joint without c_max >= 0 and d_max > 0.
+    """
+    if law is ContactLaw.IMPACT:
+        if c_max is None or d_max is None or not (c_max >= 0 and d_max > 0):
+            raise ValueError(
+                f"joint '{joint}' uses the IMPACT law: give impact_c_max >= 0 [N s/m] and "
+                f"impact_d_max > 0 [m] (got {c_max!r}, {d_max!r})"
+            )
+        return _IMPACT, 0.0, float(c_max), float(d_max)
+    if law is ContactLaw.HERTZ:
+        return _HERTZ, 0.0, 0.0, 0.0
+    return _CHI, hysteresis_factor(law, restitution), 0.0, 0.0
 
 
 @dataclass(frozen=True)
@@ -78,6 +146,17 @@ class ContactJoint:
     d_max: float
     cylinder: CylinderLaw | None = None
 
+    @property
+    def penetration_limit(self) -> float:
+        """Default penetration treated as divergence [m]: 5 % of the bearing radius, or a
+        cylindrical law's deepest penetration δ* if shallower (beyond it the law gives no force)."""
+        limit = 0.05 * self.rb
+        return limit if self.cylinder is None else min(limit, self.cylinder.max_penetration)
+
+    def evaluate(self, zl: Sequence[float], zdl: Sequence[float], vin: float) -> tuple[float, ...]:
+        """`evaluate_contact` of this joint."""
+        return evaluate_contact(self, zl, zdl, vin)
+
 
 def contact_joints(
     joints: Sequence[Joint],
@@ -102,8 +181,7 @@ def contact_joints(
         ValueError: bad thresholds, an IMPACT joint without c_max and d_max, or a
             clearance that names no journal link.
     """
-    if not (math.isfinite(v0) and math.isfinite(v1) and 0 <= v0 < v1):
-        raise ValueError(f"friction thresholds must satisfy 0 <= v0 < v1 [m/s] (got {v0!r}, {v1!r})")
+    check_thresholds(v0, v1)
     out = []
     for j in joints:
         cl = j.clearance
@@ -116,18 +194,7 @@ def contact_joints(
             bl, sj, sb = j.link_b, rel(j.link_a, j.point_a), rel(j.link_b, j.point_b)
         else:
             bl, sj, sb = j.link_a, rel(j.link_b, j.point_b), rel(j.link_a, j.point_a)
-        cm = dm = 0.0
-        if cl.law is ContactLaw.IMPACT:
-            if c_max is None or d_max is None or not (c_max >= 0 and d_max > 0):
-                raise ValueError(
-                    f"joint '{j.name}' uses the IMPACT law: give impact_c_max >= 0 [N s/m] and "
-                    f"impact_d_max > 0 [m] (got {c_max!r}, {d_max!r})"
-                )
-            kind, chi, cm, dm = _IMPACT, 0.0, float(c_max), float(d_max)
-        elif cl.law is ContactLaw.HERTZ:
-            kind, chi = _HERTZ, 0.0
-        else:
-            kind, chi = _CHI, hysteresis_factor(cl.law, cl.restitution)
+        kind, chi, cm, dm = law_terms(cl.law, cl.restitution, j.name, c_max, d_max)
         out.append(
             ContactJoint(
                 name=j.name,
@@ -156,7 +223,7 @@ def contact_joints(
     return out
 
 
-def normal_force_scalar(cj: ContactJoint, delta: float, delta_dot: float, vin: float) -> float:
+def normal_force_scalar(cj: LawPoint, delta: float, delta_dot: float, vin: float) -> float:
     """Normal force [N] >= 0 of ``cj``'s law at penetration delta [m], rate delta_dot [m/s].
 
     ``vin`` is the approach speed at onset [m/s] (> 0). Zero for delta <= 0.
@@ -180,7 +247,7 @@ def normal_force_scalar(cj: ContactJoint, delta: float, delta_dot: float, vin: f
     return f if f > 0.0 else 0.0
 
 
-def friction_scalar(cj: ContactJoint, fn: float, vt: float) -> float:
+def friction_scalar(cj: LawPoint, fn: float, vt: float) -> float:
     """Ambrosio friction F_T [N] along t for normal force fn [N], tangential speed vt [m/s]."""
     if cj.mu == 0.0 or fn == 0.0:
         return 0.0

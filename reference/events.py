@@ -1,15 +1,17 @@
-"""Contact onset and end of a clearance joint within one integrator step.
+"""Contact onset and end of a contact point (a clearance joint or a slider's corner) within one step.
 
 Within a step the solver's dense output gives the state at any time; the penetration
-delta(t) = |e(t)| - c of each joint is a derived scalar. A free joint changes mode where
-delta becomes > 0 (onset); a joint in contact where delta becomes < 0 (end).
+delta(t) of each contact point is a derived scalar (a journal: |e(t)| - c; a slider's corner:
+its depth beyond its guide line). A free point changes mode where delta becomes > 0
+(onset); a point in contact where delta becomes < 0 (end).
 
 Strategy (no impact may be stepped over, yet most steps cost nothing):
 
-1. Reach test (no dense output): over a step of length h the eccentricity travels at most
-   D = 2 h max(|e_dot(t0)|, |e_dot(t1)|) (factor 2: speed changes within a step), so delta
-   stays below (delta0 + delta1 + D) / 2 and above (delta0 + delta1 - D) / 2. If the wall
-   cannot be reached, there is nothing to look for.
+1. Reach test (no dense output): over a step of length h delta changes by at most
+   D = 2 h max(r(t0), r(t1)) (factor 2: speeds change within a step), r a bound on its rate
+   (a journal: |e_dot|; a corner: its speed across the guide, sliding along it excluded), so
+   delta stays below (delta0 + delta1 + D) / 2 and above (delta0 + delta1 - D) / 2. If the
+   wall cannot be reached, there is nothing to look for.
 2. Scan: otherwise the step is cut into n sub-intervals over which the journal travels at
    most c / 4; delta and delta_dot are taken from the dense output at their ends and a
    cubic Hermite bounds delta inside each (its error ~ (c/4)^4 / (384 c^3) << c). The
@@ -27,7 +29,8 @@ import numpy as np
 from numpy.typing import ArrayLike
 from scipy.optimize import brentq, minimize_scalar
 
-from clearance.reference.contact import evaluate_contact
+from clearance.reference.contact import ContactJoint
+from clearance.reference.corner_contact import corner_gap, corner_gaps_many
 from clearance.reference.system import ReferenceSystem
 
 __all__ = ["gap", "gap_many", "hermite_extreme", "find_mode_change"]
@@ -39,15 +42,25 @@ _Column = np.ndarray | float
 
 
 def gap(system: ReferenceSystem, k: int, y: np.ndarray) -> tuple[float, float, float]:
-    """(delta [m], delta_dot [m/s], |e_dot| [m/s]) of clearance joint k in state y."""
+    """(delta [m], delta_dot [m/s], rate bound [m/s]) of contact point k in state y.
+
+    The rate bound is |e_dot| for a journal and, for a slider's corner, its speed across the
+    guide (`clearance.reference.corner_contact.corner_gaps_many`).
+    """
     nq = system.nq
-    r = evaluate_contact(system.contacts[k], y[:nq].tolist(), y[nq : 2 * nq].tolist(), 0.0)
+    cp = system.contacts[k]
+    if not isinstance(cp, ContactJoint):
+        return corner_gap(cp, y[:nq].tolist(), y[nq : 2 * nq].tolist())
+    r = cp.evaluate(y[:nq].tolist(), y[nq : 2 * nq].tolist(), 0.0)
     return r[4], r[5], math.hypot(r[2], r[3])
 
 
 def gap_many(system: ReferenceSystem, k: int, ys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(delta, delta_dot) of joint k for states ys of shape (ny, n), vectorised."""
+    """(delta, delta_dot) of contact point k for states ys of shape (ny, n), vectorised."""
     cj, nq = system.contacts[k], system.nq
+    if not isinstance(cj, ContactJoint):
+        delta, ddot, _ = corner_gaps_many(cj, nq, ys)
+        return delta, ddot
 
     def centre(i: int, s: tuple[float, float]) -> tuple[_Column, _Column, _Column, _Column]:
         if i < 0:
@@ -97,11 +110,11 @@ def find_mode_change(
     g1: tuple[float, float, float],
     in_contact: bool,
 ) -> float | None:
-    """First time in (t0, t1] at which joint k changes mode, or None.
+    """First time in (t0, t1] at which contact point k changes mode, or None.
 
     Args:
         system: the system.
-        k: clearance joint index.
+        k: contact point index.
         dense: returns the step's dense output (built on first call only).
         t0, t1: step start and end [s].
         g0, g1: `gap` at the step ends.

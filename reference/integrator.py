@@ -3,12 +3,17 @@
 The loop drives a scipy `OdeSolver` (LSODA by default) one step at a time through its
 public interface (`step`, `dense_output`, `t_old`, `t`, `y`, `step_size`):
 
-  * Contact state is a mode per clearance joint: free, or in contact with the approach
-    speed delta_dot^- recorded at onset. The right-hand side applies a force only in
-    contact mode, so a step that crosses an onset is smooth free flight; the crossing is
-    then located on the step's dense output (`clearance.reference.events`), the step is
-    cut there and the solver restarts in the new mode with the last step size. No impact
-    can be stepped over and delta_dot^- is exact to the tolerance.
+  * Contact state is a mode per contact point (a clearance joint's journal, a slider's
+    corner): free, or in contact with the approach speed delta_dot^- recorded at onset. The
+    right-hand side applies a force only in contact mode, so a step that crosses an onset is
+    smooth free flight; the crossing is then located on the step's dense output
+    (`clearance.reference.events`), the step is cut there and the solver restarts in the new
+    mode with the last step size. No impact can be stepped over and delta_dot^- is exact to
+    the tolerance. Points that switch at the same instant switch together: at a located
+    switch every other free point already touching and approaching (delta >= 0,
+    delta_dot > 0) starts its impact there, and every other point in contact already clear
+    and receding (delta <= 0, delta_dot < 0) ends it (a level slider lands on two corners
+    at once).
   * Output samples on a uniform grid come from the dense output of the step holding them.
   * Coordinate projection (optional) restarts the solver after any step whose constraint
     drift exceeds the position or velocity tolerance.
@@ -109,7 +114,7 @@ def integrate_system(
             any step whose constraint residual exceeds them, project and restart; None for
             no projection.
         track_work: also integrate the work of each drive.
-        max_penetration: per clearance joint, penetration [m] treated as divergence.
+        max_penetration: per contact point, penetration [m] treated as divergence.
         progress: called with the time reached [s] after each output sample.
 
     Returns:
@@ -205,15 +210,16 @@ def integrate_system(
             if event:
                 te, k = event
                 y = dense()(te) if te < t1s else y1.copy()
-                delta, ddot, _ = gap(system, k, y)
-                if vin[k] > 0:
-                    vin[k] = 0.0
-                    traj.ends.append((te, k))
-                else:
-                    vin[k] = max(ddot, system.min_approach_speed)
-                    traj.onsets.append((te, k, vin[k]))
-                t, h, restart = te, solver.step_size, True
                 geo = [gap(system, i, y) for i in range(nc)]
+                for i in range(nc):
+                    delta, ddot, _ = geo[i]
+                    if vin[i] > 0 and (i == k or (delta <= 0.0 and ddot < 0.0)):
+                        vin[i] = 0.0
+                        traj.ends.append((te, i))
+                    elif vin[i] == 0.0 and (i == k or (delta >= 0.0 and ddot > 0.0)):
+                        vin[i] = max(ddot, system.min_approach_speed)
+                        traj.onsets.append((te, i, vin[i]))
+                t, h, restart = te, solver.step_size, True
             else:
                 t, y, geo = t1s, y1, geo1
             for k, (delta, _, _) in enumerate(geo):

@@ -15,7 +15,9 @@ that sample) for accelerations, contact forces and drive torques. Frames and sig
     ideal joint from the Lagrange multipliers of its two rows (M zdd + G' lambda = Q, so a
     revolute row pair p_a - p_b = 0 gives link_b the force +lambda; a prismatic pair's distance
     row n . (p_b - p_a) = 0 gives link_b -lambda_2 n, n the guide's normal), for a clearance joint
-    its contact force (on the journal, signed by which side the journal is).
+    its contact force (on the journal, signed by which side the journal is), for a slider with
+    play the sum of its corners' contact forces on the slider;
+  * sliders: per prismatic joint with play a `SliderResult` in the guide frame (`_slider`).
 """
 
 from __future__ import annotations
@@ -25,9 +27,12 @@ from typing import Any
 import numpy as np
 
 from clearance.kinematics import output_kinematics
+from clearance.reference.contact import ContactJoint
+from clearance.reference.corner_contact import CornerContact
 from clearance.reference.integrator import Trajectory
 from clearance.reference.system import ReferenceSystem
 from clearance.results import JointResult, SimulationResult, energy_balance
+from clearance.translational import SliderResult, classify_contact
 
 __all__ = ["assemble_result"]
 
@@ -63,6 +68,8 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
 
     joints: dict[str, JointResult] = {}
     for k, cj in enumerate(system.contacts):
+        if not isinstance(cj, ContactJoint):
+            continue
         ex, ey, edx, edy = (cres[:, k, i] for i in range(4))
         fx, fy = cres[:, k, 7], cres[:, k, 8]
         if cj.ib >= 0:
@@ -78,6 +85,11 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
         joints[cj.name] = JointResult(e, erate, pen, force)
 
     reactions = _reactions(system, q, lam, cres)
+    corners: dict[str, list[int]] = {}
+    for k, cj in enumerate(system.contacts):
+        if isinstance(cj, CornerContact):
+            corners.setdefault(cj.name, []).append(k)
+    sliders = {name: _slider(system, traj, cres, ks) for name, ks in corners.items()}
     angle, speed = np.empty((n, nd)), np.empty((n, nd))
     for k, d in enumerate(system.drives):
         tb = q[:, 3 * d.ib + 2] if d.ib >= 0 else 0.0
@@ -118,6 +130,55 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
         metadata=meta,
         energy=energy,
         joint_reactions=reactions,
+        sliders=sliders,
+    )
+
+
+def _slider(system: ReferenceSystem, traj: Trajectory, cres: np.ndarray, ks: list[int]) -> SliderResult:
+    """The `SliderResult` of one slider with play from its four corner contacts ``ks``.
+
+    The slider's centre (point_b) is the mean of its corners; the guide frame turns with the
+    guide link: a guide-frame coordinate x = u_w . d has rate u_w . d_dot + w_a n_w . d.
+    """
+    cc = [system.contacts[k] for k in ks]
+    first = cc[0]
+    assert isinstance(first, CornerContact)
+    i, g = first.ij, first.ib
+    z, zd = traj.z, traj.zd
+    n = len(z)
+    sk = np.mean([c.sk for c in cc if isinstance(c, CornerContact)], axis=0)
+    th, w = z[:, 3 * i + 2], zd[:, 3 * i + 2]
+    c, s = np.cos(th), np.sin(th)
+    ax, ay = c * sk[0] - s * sk[1], s * sk[0] + c * sk[1]
+    p = np.stack([z[:, 3 * i] + ax, z[:, 3 * i + 1] + ay], axis=1)
+    pv = np.stack([zd[:, 3 * i] - w * ay, zd[:, 3 * i + 1] + w * ax], axis=1)
+    if g >= 0:
+        tg, wg = z[:, 3 * g + 2], zd[:, 3 * g + 2]
+        cg, sg = np.cos(tg), np.sin(tg)
+        bx, by = cg * first.sg[0] - sg * first.sg[1], sg * first.sg[0] + cg * first.sg[1]
+        gp = np.stack([z[:, 3 * g] + bx, z[:, 3 * g + 1] + by], axis=1)
+        gv = np.stack([zd[:, 3 * g] - wg * by, zd[:, 3 * g + 1] + wg * bx], axis=1)
+        u = np.stack([cg * first.u[0] - sg * first.u[1], sg * first.u[0] + cg * first.u[1]], axis=1)
+    else:
+        tg, wg = np.zeros(n), np.zeros(n)
+        gp, gv = np.broadcast_to(first.sg, (n, 2)), np.zeros((n, 2))
+        u = np.broadcast_to(first.u, (n, 2))
+    nrm = np.stack([-u[:, 1], u[:, 0]], axis=1)
+    d, dv = p - gp, pv - gv
+    along, across = np.sum(u * d, axis=1), np.sum(nrm * d, axis=1)
+    position = np.stack([along, across], axis=1)
+    velocity = np.stack([np.sum(u * dv, axis=1) + wg * across, np.sum(nrm * dv, axis=1) - wg * along], axis=1)
+    pen = cres[:, ks, 4]
+    force = cres[:, ks, 7:9].sum(axis=1)
+    return SliderResult(
+        position=position,
+        velocity=velocity,
+        tilt=th - tg - system.offsets[first.name],
+        tilt_rate=w - wg,
+        corner_penetration=pen,
+        corner_force=cres[:, ks, 11],
+        contact_force=np.stack([np.sum(u * force, axis=1), np.sum(nrm * force, axis=1)], axis=1),
+        contact_case=classify_contact(pen),
     )
 
 
@@ -142,6 +203,9 @@ def _reactions(system: ReferenceSystem, q: np.ndarray, lam: np.ndarray, cres: np
         normal = np.stack([c * ux - s * uy, s * ux + c * uy], axis=1)
         out[name] = -lam[:, 2 * k + 1 : 2 * k + 2] * normal
     for k, cj in enumerate(system.contacts):
+        if isinstance(cj, CornerContact):  # force on the slider, link_b: its corners' sum
+            out[cj.name] = out[cj.name] + cres[:, k, 7:9] if cj.name in out else cres[:, k, 7:9].copy()
+            continue
         on_journal = cres[:, k, 7:9]
         out[cj.name] = -on_journal if system.joint_links[cj.name][0] == cj.journal_link else on_journal.copy()
     return {name: out[name] for name in system.joint_links if name in out}

@@ -17,6 +17,7 @@ import numpy as np
 from clearance.checks import positive
 from clearance.contact_calibration.laws import MIN_APPROACH_SPEED, STIFFNESS_FORMULA
 from clearance.model import DriveKind, Mechanism
+from clearance.reference.corner_contact import CornerContact
 from clearance.reference.integrator import (
     METHODS,
     IntegrationFailure,
@@ -121,7 +122,7 @@ def simulate_system(
             5 1/s) at about the same cost (benchmarks/reference_speed.md): Baumgarte's 0.2 s
             time constant is slow against a 12 ms revolution.
         max_penetration: penetration [m] treated as divergence; default 5 % of each
-            bearing radius.
+            bearing radius, and a slider's whole clearance for its corners.
         track_work: also integrate the work of each drive (metadata ``drive_work``, (n,
             n_drives) [J], and ``energy`` series for the energy balance).
         progress: True for a tqdm bar, or a callable progress(t [s], duration [s]).
@@ -163,7 +164,7 @@ def simulate_system(
         if not np.all(np.isfinite(atol_v) & (atol_v > 0)):
             raise ValueError(f"atol must be positive and finite (got {atol!r})")
     if max_penetration is None:
-        limits = [0.05 * cj.rb for cj in system.contacts]
+        limits = [cj.penetration_limit for cj in system.contacts]
     else:
         limits = [positive("max_penetration", max_penetration, "m")] * len(system.contacts)
     if stab is not Stabilisation.BAUMGARTE and (system.alpha or system.beta):
@@ -343,20 +344,35 @@ def to_result(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any
 
 
 def _metadata(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any]) -> dict[str, Any]:
+    """The run's metadata. A slider's four corners are one joint in ``impacts``,
+    ``contact_onsets`` ([t, approach speed]) and ``contact_ends``; ``corner_onsets`` and
+    ``corner_ends`` add the corner (`clearance.translational.CORNERS`) for sliders, and ``guides``
+    each slider's clearance, block size [m] and largest tilt [rad]."""
     mech = system.mechanism
-    onsets: dict[str, list[list[float]]] = {n: [] for n in system.contact_names}
-    ends: dict[str, list[float]] = {n: [] for n in system.contact_names}
+    names = list(dict.fromkeys(system.contact_names))
+    onsets: dict[str, list[list[float]]] = {n: [] for n in names}
+    ends: dict[str, list[float]] = {n: [] for n in names}
+    sliders = {cj.name for cj in system.contacts if isinstance(cj, CornerContact)}
+    corner_onsets: dict[str, list[list[float]]] = {n: [] for n in sliders}
+    corner_ends: dict[str, list[list[float]]] = {n: [] for n in sliders}
     for t, k, v in traj.onsets:
-        onsets[system.contact_names[k]].append([t, v])
+        cp = system.contacts[k]
+        onsets[cp.name].append([t, v])
+        if isinstance(cp, CornerContact):
+            corner_onsets[cp.name].append([t, v, cp.corner])
     for t, k in traj.ends:
-        ends[system.contact_names[k]].append(t)
+        cp = system.contacts[k]
+        ends[cp.name].append(t)
+        if isinstance(cp, CornerContact):
+            corner_ends[cp.name].append([t, cp.corner])
     return {
         "solver": "reference",
         **settings,
         "baumgarte": [system.alpha, system.beta],
         "mechanism": system.name,
         "parameters": dict(mech.parameters) if mech is not None else {},
-        "clearance_joints": list(system.contact_names),
+        "clearance_joints": [n for n in names if n not in sliders],
+        "translational_joints": sorted(sliders, key=names.index),
         "drives": list(system.drive_names),
         "links": list(system.link_names),
         "contact_law": {cj.name: cj.clearance.law.value for cj in system.contacts},
@@ -372,6 +388,18 @@ def _metadata(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any
         "impacts": {n: len(v) for n, v in onsets.items()},
         "contact_onsets": onsets,
         "contact_ends": ends,
+        "corner_onsets": corner_onsets,
+        "corner_ends": corner_ends,
+        "guides": {
+            cj.name: {
+                "clearance": cj.clearance.clearance,
+                "slider_length": cj.clearance.slider_length,
+                "slider_height": cj.clearance.slider_height,
+                "max_tilt": cj.clearance.max_tilt,
+            }
+            for cj in system.contacts
+            if isinstance(cj, CornerContact)
+        },
         "n_rhs": traj.n_rhs,
         "n_steps": traj.n_steps,
         "n_restarts": traj.n_restarts,

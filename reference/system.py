@@ -18,7 +18,6 @@ system (G M^-1 G^T) lambda = G M^-1 Q - gamma_s: one dense solve per call.
 
 from __future__ import annotations
 
-import dataclasses
 import math
 from collections.abc import Sequence
 from typing import NamedTuple, TypedDict, Unpack
@@ -29,9 +28,10 @@ from scipy.linalg.lapack import dposv
 from clearance.contact_calibration.cylindrical_laws import elastic_energy
 from clearance.contact_calibration.laws import MIN_APPROACH_SPEED
 from clearance.kinematics import assemble, velocities
-from clearance.model import Drive, DriveKind, Joint, Link, Mechanism, MotionLaw
+from clearance.model import Drive, DriveKind, Joint, Link, Mechanism
 from clearance.reference.constraints import ConstraintRows
-from clearance.reference.contact import ContactJoint, contact_joints, evaluate_contact
+from clearance.reference.contact import ContactJoint, contact_joints
+from clearance.reference.corner_contact import CornerContact, corner_contacts
 
 __all__ = ["ReferenceSystem", "ReferenceOptions", "SingularConstraintsError", "Evaluation"]
 
@@ -79,7 +79,8 @@ class Evaluation(NamedTuple):
         zdd: (nq,) accelerations [m/s^2, rad/s^2].
         lam: (n_constraints,) multipliers [N or N m].
         phi: constraint residuals (list) [m or rad].
-        contacts: per clearance joint the tuple of `contact.evaluate_contact`.
+        contacts: per contact point (`ReferenceSystem.contacts`) the tuple of
+            `contact.evaluate_contact` or `corner_contact.evaluate_corner`.
         drive_torque: (n_drives,) torque each drive applies to its link_b [N m].
     """
 
@@ -211,20 +212,20 @@ class ReferenceSystem:
         guess = {lk.name: lk.pose_guess for lk in links}
         guess[ground] = (0.0, 0.0, 0.0)
         offsets = {j.name: guess[j.link_b][2] - guess[j.link_a][2] for j in joints}
+        self.offsets = offsets
+        """joint name -> theta_b - theta_a at assembly [rad] (a prismatic joint's zero tilt)."""
         self.rows = ConstraintRows(joints, drives, index, rel, offsets, self.nq)
         self.n_constraints = self.rows.n
         self.drives = self.rows.drives
         self.drive_names = [d.name for d in self.drives]
-        self.contacts: list[ContactJoint] = contact_joints(
-            joints,
-            index,
-            rel,
-            v0=float(o["friction_v0"]),
-            v1=float(o["friction_v1"]),
-            c_max=o["impact_c_max"],
-            d_max=o["impact_d_max"],
-        )
+        v0, v1, c_max, d_max = float(o["friction_v0"]), float(o["friction_v1"]), o["impact_c_max"], o["impact_d_max"]
+        self.contacts: list[ContactJoint | CornerContact] = [
+            *contact_joints(joints, index, rel, v0=v0, v1=v1, c_max=c_max, d_max=d_max),
+            *corner_contacts(joints, index, rel, offsets, v0=v0, v1=v1, c_max=c_max, d_max=d_max),
+        ]
+        """The contact points: each clearance joint's journal, then each slider's four corners."""
         self.contact_names = [c.name for c in self.contacts]
+        """The joint of each contact point (a slider's name four times)."""
         self._torque = [(d.ia, d.ib, d.torque) for d in self.drives if d.kind is DriveKind.TORQUE]
         # row of each prescribed drive among the constraints, -1 for torque drives
         base, k, self._drive_row = 2 * len(self.rows.pairs), 0, []
@@ -265,10 +266,10 @@ class ReferenceSystem:
         return q, qd, qdd
 
     def initial_state(self) -> tuple[np.ndarray, np.ndarray]:
-        """The ideal mechanism assembled at t = 0 with ideal velocities, journals centred.
+        """The ideal mechanism assembled at t = 0 with ideal velocities, journals and sliders centred.
 
-        A torque-driven joint starts at its drive's start angle, at rest relative to its
-        other link.
+        A torque-driven joint starts at its drive's start angle, turning at the drive's
+        initial speed relative to its other link.
 
         Returns:
             (q, qd): link-frame coordinates (nq,) [m, rad] and velocities [m/s, rad/s].
@@ -279,19 +280,9 @@ class ReferenceSystem:
         """
         if self.mechanism is None:
             raise ValueError("a system built from parts has no assembly: give q0 and qd0")
-        mech = self.mechanism
-        if any(d.kind is DriveKind.TORQUE for d in mech.drives):
-            # hold torque-driven joints at their start angle, at rest, for the assembly
-            held = MotionLaw(0.0, period=1.0)
-            mech = dataclasses.replace(
-                mech,
-                drives=tuple(
-                    dataclasses.replace(d, kind=DriveKind.MOTION_LAW, motion=held) if d.kind is DriveKind.TORQUE else d
-                    for d in mech.drives
-                ),
-            )
-        q = assemble(mech, 0.0)
-        return q, velocities(mech, q, 0.0)
+        # kinematics sees a torque drive at its start angle, turning at its initial speed
+        q = assemble(self.mechanism, 0.0)
+        return q, velocities(self.mechanism, q, 0.0)
 
     # -- dynamics ----------------------------------------------------------------------------
     def evaluate(self, t: float, zl: Sequence[float], zdl: Sequence[float], vin: Sequence[float]) -> Evaluation:
@@ -300,7 +291,7 @@ class ReferenceSystem:
         Args:
             t: time [s].
             zl, zdl: centre-of-mass coordinates and velocities (nq,) as floats.
-            vin: per clearance joint the approach speed of the current impact [m/s], or 0
+            vin: per contact point the approach speed of the current impact [m/s], or 0
                 for a joint not in contact mode.
 
         Returns:
@@ -317,7 +308,7 @@ class ReferenceSystem:
                 q[3 * ia + 2] -= tau
         cres = []
         for cj, v in zip(self.contacts, vin):
-            r = evaluate_contact(cj, zl, zdl, v)
+            r = cj.evaluate(zl, zdl, v)
             cres.append(r)
             if r[11] != 0.0 or r[7] != 0.0 or r[8] != 0.0 or r[9] != 0.0:  # dry contact, or an oil film
                 if not math.isfinite(r[11]):  # a rejected trial stage far outside the physics
@@ -368,7 +359,7 @@ class ReferenceSystem:
             t: time [s].
             y: state (z, zd) of length 2 nq, optionally followed by the work done by each
                 drive [J] (then its power is returned there).
-            vin: per clearance joint the current approach speed [m/s] or 0 (free).
+            vin: per contact point the current approach speed [m/s] or 0 (free).
 
         Returns:
             dy/dt, same length as y.
@@ -430,7 +421,7 @@ class ReferenceSystem:
             grav -= lk.mass * (gx * z[..., 3 * i] + gy * z[..., 3 * i + 1])
         pot = np.zeros(z.shape[:-1])
         for cj in self.contacts:
-            delta = np.array([evaluate_contact(cj, zi, zi, 0.0)[4] for zi in z.reshape(-1, self.nq).tolist()]).reshape(
+            delta = np.array([cj.evaluate(zi, zi, 0.0)[4] for zi in z.reshape(-1, self.nq).tolist()]).reshape(
                 z.shape[:-1]
             )
             if isinstance(cj, ContactJoint) and cj.cylinder is not None:

@@ -29,6 +29,7 @@ FLOORS: dict[str, str] = {
     "clearance.lubrication": "data model",
     "clearance.loads": "inverse dynamics",
     "clearance.builders": "builders",
+    "clearance.translational": "data model",
     "clearance.mjcf": "mjcf",
     "clearance.contact_calibration.laws": "contact laws",
     "clearance.contact_calibration.film": "contact laws",

@@ -395,6 +395,10 @@ def _report_lines(
     lines += _deviation_lines(result, ideal, output, window, out)
     if result.joints:
         lines += contact_section(result, window, out)
+    if result.sliders:  # sliders with play: position and tilt in the guide, contact cases
+        from clearance.analysis.figures.slider_figures import slider_section
+
+        lines += slider_section(result, out)
     if has_reactions:  # the joint reactions' section, where the result has them
         lines += reactions_section(result, ideal, window, out, reactions)
     lines += energy_section(result)

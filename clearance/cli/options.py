@@ -111,6 +111,7 @@ def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, cont
         default=None,
         metavar="JOINT",
         help="joints with clearance (default: the builder's, rod_slider for the slider-crank); "
+        "a slider's prismatic joint (slider_guide) gets play in its guide (clearance reference only); "
         "give none for the ideal mechanism",
     )
     g.add_argument(
@@ -234,7 +235,7 @@ def _catalogue_from_args(args: argparse.Namespace) -> Mechanism:
 
     name = args.mechanism or DEFAULT_MECHANISM
     entry = CATALOGUE[name]
-    check_clearance_at(args.clearance_at, name)
+    check_clearance_at(args.clearance_at, name, sliders=True)
     builder, speed = entry.builder, entry.speed_keyword
     accepted = inspect.signature(builder).parameters
     overrides = [
@@ -266,8 +267,13 @@ def _shown(args: argparse.Namespace, flag: str) -> str:
     return " ".join(v) if isinstance(v, list) else f"{v:g}"
 
 
-def check_clearance_at(joints: list[str] | None, mechanism: str) -> None:
+def check_clearance_at(joints: list[str] | None, mechanism: str, *, sliders: bool = False) -> None:
     """Refuse ``--clearance-at`` joints that the catalogue mechanism cannot give a clearance, or repeated.
+
+    Args:
+        joints: the joints given, or None.
+        mechanism: the catalogue mechanism.
+        sliders: also accept the prismatic joints of its sliders (a translational clearance).
 
     Raises:
         ValueError: naming the joints and the choices.
@@ -276,12 +282,18 @@ def check_clearance_at(joints: list[str] | None, mechanism: str) -> None:
 
     if joints is None:
         return
-    clearable = CATALOGUE[mechanism].info.clearable
+    info = CATALOGUE[mechanism].info
+    clearable = (*info.clearable, *info.sliders) if sliders else info.clearable
     unknown = [j for j in joints if j not in clearable]
     if unknown:
+        where = (
+            f" (a slider's play, at {', '.join(info.sliders)}, runs in 'clearance reference' only so far)"
+            if info.sliders and not sliders
+            else ""
+        )
         raise ValueError(
             f"--clearance-at {' '.join(unknown)}: unknown joint(s) of mechanism '{mechanism}'; the joints that can "
-            f"carry a clearance are {', '.join(clearable)} (or give none for the ideal mechanism)"
+            f"carry a clearance are {', '.join(clearable)} (or give none for the ideal mechanism){where}"
         )
     twice = sorted({j for j in joints if joints.count(j) > 1})
     if twice:

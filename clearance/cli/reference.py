@@ -18,6 +18,7 @@ from clearance.cli.options import (
 from clearance.cli.outputs import check_output_paths, duration_from_args, duration_source, write_outputs
 from clearance.cli.paths import folder_lock
 from clearance.model import Mechanism
+from clearance.results import SimulationResult
 
 __all__ = ["add_parser", "command"]
 
@@ -83,7 +84,7 @@ def _reference(args: argparse.Namespace, mech: Mechanism, duration: float, inter
     from clearance.reference import ReferenceSolverError, run_reference
 
     print(
-        f"{mech.name} (reference solver): clearance at {[j.name for j in mech.clearance_joints]}, "
+        f"{mech.name} (reference solver): clearance at {[j.name for j in mech.joints if j.has_play]}, "
         f"{duration * 1e3:.3g} ms, rtol {args.rtol:g}"
     )
     progress = not args.no_progress
@@ -103,8 +104,26 @@ def _reference(args: argparse.Namespace, mech: Mechanism, duration: float, inter
         print(f"error: the ideal twin (no clearance), needed for the deviations: {err}", file=sys.stderr)
         return 2
     write_outputs(args, mech, result, ideal, out)
+    for line in _slider_lines(result):
+        print(line)
     print(f"  wall time {result.metadata.get('wall_time_s', float('nan')):.3g} s; wrote {out}/")
     if failed is not None:
         print(f"error: {failed}", file=sys.stderr)
         return 2
     return 0
+
+
+def _slider_lines(result: SimulationResult) -> list[str]:
+    """One console line per slider with play: time in each contact case, largest tilt and force."""
+    from clearance.analysis.metrics.slider import slider_summary
+    from clearance.units import format_quantity as q
+
+    lines = []
+    for joint, sr in result.sliders.items():
+        s = slider_summary(result.times, sr)
+        shares = ", ".join(f"{c.name.lower().replace('_', ' ')} {v:.1%}" for c, v in s.shares.items())
+        lines.append(
+            f"  {joint}, whole run: {shares} ({s.switches} switches); largest tilt {q(s.max_tilt, 'rad')}, "
+            f"peak corner force {q(s.peak_corner_force, 'N')}, max penetration {q(s.max_penetration, 'm')}"
+        )
+    return lines

@@ -32,6 +32,7 @@ from clearance.mjcf import (
     apply_contact,
     build_spec,
     choose_segments,
+    refuse_translational_clearance,
 )
 from clearance.model import DriveKind, Joint, Mechanism
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
@@ -146,8 +147,10 @@ def prepare(
     Raises:
         AssemblyError: the mechanism cannot be assembled.
         TimeStepError: the time step is too large for some contact's stiffness.
-        ValueError: bad options.
+        ValueError: bad options; a slider with play (translational clearance runs in the
+            reference solver only so far).
     """
+    refuse_translational_clearance(mechanism)  # before any work: MuJoCo has no slider with play yet
     options = options or ModelOptions()
     cjoints = mechanism.clearance_joints
     exact = options.contact_mode is ContactMode.EXACT
