@@ -33,6 +33,7 @@ FLOORS: dict[str, str] = {
     "clearance.mjcf": "mjcf",
     "clearance.contact_calibration.laws": "contact laws",
     "clearance.contact_calibration.film": "contact laws",
+    "clearance.contact_calibration.cylindrical_laws": "contact laws",
     "clearance.contact_calibration": "contact",
     "clearance.contact_plugin": "contact",
     "clearance.retrofit": "retrofit",
