@@ -306,7 +306,20 @@ def main() -> None:
     for s in sic:
         moved, share, phases = contact_cells(s)
         text.append(f"| {s.name} | {moved} | (rigid) | (impulses) | {share} | {phases} | 0 | {s.energy[-1]:.4f} J | |")
-    text.append("")
+    from clearance.contact_calibration.impact import law_impact
+
+    rebounds = {
+        law: law_impact(law, mass=0.1, speed=0.84, stiffness=tc.stiffness, restitution=0.4).restitution
+        for law in (ContactLaw.FLORES, ContactLaw.GONTHIER, ContactLaw.LANKARANI_NIKRAVESH)
+    }
+    text += [
+        "",
+        "Restitution of one impact at c_e = 0.4 (the calibration's impact reference: 0.1 kg at 0.84 m/s, the "
+        "first impact's approach speed, K as the scenario's): "
+        + ", ".join(f"{law.value} {e:.3f}" for law, e in rebounds.items())
+        + ".",
+        "",
+    ]
     print(write_keeping_reading(HERE / "translational_clearance.md", "\n".join(text)))
 
 
