@@ -53,7 +53,7 @@ def test_bifurcation_sweep_and_figure(tmp_path):
         executor=_Inline(),
         progress=False,
     )
-    np.testing.assert_array_equal(d.values, values)
+    np.testing.assert_array_equal(d.values, values)  # the points' values, copied
     assert d.quantity == "rod_slider.ex" and d.errors == ("", "")
     # sections at t = 2T and 3T: the run ends one step before 4T
     assert [len(s) for s in d.samples] == [2, 2]
@@ -81,7 +81,7 @@ def test_bifurcation_from_rows_marks_failed_points():
     ]
     d = bifurcation_from_rows(rows, "c")
     assert d.regimes == ("periodic", "error") and d.quantity == "q"
-    x, y = d.scatter()
+    x, y = d.scatter()  # the rows' numbers, copied: exact
     np.testing.assert_array_equal(x, [1.0, 1.0])
     np.testing.assert_array_equal(y, [1.0, 2.0])
 

@@ -193,7 +193,7 @@ def test_oblique_impact_full_slip_loses_mu_times_normal_impulse(vt: float) -> No
     mu = 0.1
     r = simulate_oblique_impact(_ln(0.9), mass=0.21, normal_speed=1.0, tangential_speed=vt, friction=mu)
     speed = np.abs(r.tangential_velocity)
-    assert np.all(np.diff(speed) <= 1e-15)  # non-increasing (1e-15: rounding)
+    assert np.all(np.diff(speed) <= 1e-15)  # non-increasing (1e-15: rounding; measured: each sample >= 3e-9 slower)
     assert np.all(np.sign(r.tangential_velocity) == np.sign(vt))
     # |v_T| stays above v1, so c_d = 1 and Δv_T = μ · (normal impulse)/m = μ (1 + e) v.
     # Tolerance: integration error of the impulse (rtol 1e-10) with a wide margin.

@@ -141,7 +141,9 @@ def test_every_body_obeys_newton(mech, mode):
     The reactions come from the readout of a rollout; a_com from MuJoCo's own acceleration of
     the body at the row's state (`mj_objectAcceleration` after `mj_forward`), so the balance is
     exact up to rounding (measured 4e-11 N on loads of 70 kN): the bound, 1e-9 of the largest
-    reaction, leaves room for rounding only. Covers tree joints (FORCE sensors, with a compiled
+    reaction, leaves room for rounding only. The replay's solver starts from another warm start
+    than the rollout's; measured, a cold start at every row changes the balance by < 1e-14 N, as
+    the solver converges to rounding level on these rows. Covers tree joints (FORCE sensors, with a compiled
     contact's passive force added), cuts (the bodies' equations) and clearance joints, cut or
     tree edges, with the compiled contact and with a ring.
     """
@@ -179,9 +181,10 @@ def test_slider_newton_and_drive_torque_against_the_energy_meter():
     """The slider's Newton equation, and the drive torque integrating to the drive's work.
 
     Slider: guide force + pin force = m a (the output's acceleration sensor), exact to
-    rounding (1e-9 of the peak). Drive: the torque passed to the mechanism plus the armature's
-    share, times the step's mean speed, summed, is the work the energy meter (compiled, its
-    own implementation) integrates: equal to rounding (1e-9 J here; the step-start force that
+    rounding (1e-9 of the peak; measured 0). Drive: the torque passed to the mechanism plus the
+    armature's share, times the step's mean speed, summed, is the work the energy meter (compiled,
+    its own implementation) integrates: equal to rounding (measured 5e-13 J; a 4000-term sum of up
+    to 117 J rounds by ~4000 eps 117 J = 1e-10 J at most, so 1e-9 J; the step-start force that
     was reported before differed by up to 144 N m at impacts).
     """
     mech = slider_crank()

@@ -65,7 +65,7 @@ def test_result_shapes_grid_and_metadata(mech, tmp_path) -> None:
     res = run_reference(mech, 1.05e-4, output_interval=1e-5)
     n = 11  # samples at 0, 1e-5, ..., 1e-4 (the grid never passes the duration)
     assert isinstance(res, SimulationResult)
-    assert np.array_equal(res.times, 1e-5 * np.arange(n))
+    assert np.array_equal(res.times, 1e-5 * np.arange(n))  # the grid is output_interval * arange: the same products
     assert res.link_poses.shape == (n, 3, 3)
     assert res.drive_angle.shape == res.drive_speed.shape == res.drive_torque.shape == (n, 1)
     assert set(res.outputs) == {"slider_x", "slider_x_vel", "slider_x_acc"}

@@ -21,7 +21,7 @@ from clearance.reference.contact import (
 )
 from clearance.reference.examples import journal_in_bearing
 
-ULPS = 1e-12  # rel. tolerance: the same formula evaluated in floats vs NumPy (rounding)
+ULPS = 1e-12  # rel. tolerance: the same formula evaluated in floats vs NumPy (rounding; measured 6.2e-16 at most)
 IMPACT = dict(c_max=2e5, d_max=1e-5)
 
 
@@ -88,7 +88,8 @@ def test_result_frames_follow_the_conventions(crank_rod_run) -> None:
     pin = crank[:, :2] + 0.05 * np.stack([c, s], axis=1)  # bearing centre: crank point (r, 0)
     ew = rod[:, :2] - pin  # journal centre: rod frame origin
     e = np.stack([c * ew[:, 0] + s * ew[:, 1], -s * ew[:, 0] + c * ew[:, 1]], axis=1)
-    assert np.allclose(jr.eccentricity, e, rtol=0, atol=1e-15)  # same arithmetic, rounding
+    # same arithmetic (measured equal); 1e-15 m: over 100 ulps of the 0.05 m positions the difference cancels
+    assert np.allclose(jr.eccentricity, e, rtol=0, atol=1e-15)
     assert np.allclose(jr.penetration, np.hypot(e[:, 0], e[:, 1]) - 0.5e-3, rtol=0, atol=1e-15)  # idem
     # rate = time derivative of the frame-expressed vector; central differences at 1 us are
     # accurate to ~h^2 e''' / 6 ~ 1e-3 of max|rate| through the impacts (measured 4e-4)

@@ -95,7 +95,10 @@ def test_deepest_penetration_is_the_ln_impact_of_the_fastest_approach(clearance_
     mujoco.mj_forward(p.model, data)
     sites = [data.site(f"{name}__{s}").xpos[:2] for s in ("journal", "bearing")]
     normal = sites[0] - sites[1]
-    # the replay is the same stepping as the rollout: the same |e| to round-off (1e-12 m)
+    # the replay steps like the rollout but from the keyframe's velocities (the run starts from
+    # start_data's, qvel up to 8e-13 apart here) and reads |e| from the sites, not the sensors:
+    # measured 2.2e-19 m apart (one ulp); 1e-12 m covers the start's drift (< 1e-15 m over the
+    # 114 steps) and is 1e-7 of the 8.8e-6 m |e| moves in one step here, so a wrong row still fails
     assert np.hypot(*normal) == pytest.approx(np.hypot(*e[i]), abs=1e-12)
     m = normal_effective_mass(p.model, data, p.mechanism, name, normal)
     clearance = p.mechanism.joint(name).clearance

@@ -85,7 +85,8 @@ def test_run_store_digest_resume_and_names(tmp_path):
     from clearance.run.simulation import simulate
 
     full = simulate(make(point), duration=0.06, options=opts)
-    # the digest comes from every step of the same deterministic run: equal exactly
+    # the digest comes from every step of the same deterministic run: equal exactly (run_batch made
+    # this very call in its worker thread, and its JSON keeps every bit)
     assert d.outputs["slider_x_acc"]["max_abs"] == float(np.abs(full.outputs["slider_x_acc"]).max())
     assert d.joints["rod_slider"]["peak_force"] == float(full.joints["rod_slider"].force_magnitude.max())
     np.testing.assert_array_equal(kept.times, full.times[::10])
