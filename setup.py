@@ -90,6 +90,7 @@ setup(
                 "contact_plugin/journal_bearing.c",
                 "contact_plugin/work_meter.c",
                 "contact_plugin/backlash_stop.c",
+                "contact_plugin/film.c",
             ],
             extra_compile_args=["-O2", "-std=c99"],
             optional=True,

@@ -6,7 +6,7 @@ Every attribute is validated here, in Python, before anything is compiled: the p
 "plugin->init failed". The C code re-checks the same ranges, but it must never be the place a
 user error is first found.
 
-Sensor block: each instance gets one plugin sensor of 8 values, `SENSOR_FIELDS` in order:
+Sensor block: each instance gets one plugin sensor of 10 values, `SENSOR_FIELDS` in order:
 
 ====  =====================  ======  ====================================================
 slot  field                  unit    meaning
@@ -19,11 +19,15 @@ slot  field                  unit    meaning
 5     potential_energy       J       K δ^(n+1)/(n+1) for δ > 0, else 0
 6     dissipated_work        J       normal damping + friction work so far (>= 0)
 7     eccentricity           m       |e|, journal centre from bearing centre, in plane
+8     film_normal_force      N       a lubricated joint's film force on the journal along n
+                                     (negative: towards the centre); 0 for a dry joint
+9     film_tangential_force  N       the film force on the journal along t; 0 for a dry joint
 ====  =====================  ======  ====================================================
 
-Plugin state: `STATE_FIELDS` (9 values), then ``nv`` values (the last step's velocity change
-from every force but the joint's own), per instance in ``mjData.plugin_state`` (part of
-``mjSTATE_PLUGIN``); see the C file's header for their use.
+Plugin state: `STATE_FIELDS` (11 values), then 2 ``nv`` values (the last step's velocity change
+from every force but the joint's own, and its whole velocity change), per instance in
+``mjData.plugin_state`` (part of
+``mjSTATE_PLUGIN``); see journal_bearing.c's header for their use.
 """
 
 from __future__ import annotations
@@ -35,6 +39,7 @@ import mujoco
 
 from clearance.contact_calibration import laws
 from clearance.contact_plugin import PLUGIN_NAME, require
+from clearance.lubrication import Lubrication
 from clearance.model import Clearance, ContactLaw
 
 __all__ = [
@@ -59,6 +64,8 @@ SENSOR_FIELDS: tuple[str, ...] = (
     "potential_energy",
     "dissipated_work",
     "eccentricity",
+    "film_normal_force",
+    "film_tangential_force",
 )
 """Names of the plugin sensor's values, in order (units in the module docstring)."""
 
@@ -72,9 +79,12 @@ STATE_FIELDS: tuple[str, ...] = (
     "approach_speed",
     "dissipated_work",
     "steps",
+    "sample_geometric_rate",
+    "sample_film_rate",
 )
-"""Names of one instance's first values in ``mjData.plugin_state``, in order; ``nv`` more follow
-(`state_size`)."""
+"""Names of one instance's first values in ``mjData.plugin_state``, in order; two blocks of ``nv``
+more follow (`state_size`): the last step's velocity change from every force but the joint's
+own, then its whole velocity change."""
 
 COMPILED_LAWS: tuple[ContactLaw, ...] = (
     ContactLaw.HERTZ,
@@ -85,7 +95,7 @@ COMPILED_LAWS: tuple[ContactLaw, ...] = (
     ContactLaw.HU_GUO,
     ContactLaw.IMPACT,
 )
-"""The laws the compiled contact knows (``kLawNames`` of clearance_contact.c, codes 0..6 in
+"""The laws the compiled contact knows (``kLawNames`` of contact_laws.c, codes 0..6 in
 `ContactLaw` order); a port of a law adds it here. Any other law is refused before anything
 is compiled (`require_compiled_law`)."""
 
@@ -155,6 +165,8 @@ def add_journal_bearing(
     v0: float = 1e-4,
     v1: float = 1e-3,
     min_approach_speed: float = laws.MIN_APPROACH_SPEED,
+    lubrication: Lubrication | None = None,
+    bearing_length: float | None = None,
 ) -> None:
     """Add one journal–bearing contact (plugin instance + its sensor, both named ``name``).
 
@@ -182,12 +194,16 @@ def add_journal_bearing(
         v0: Ambrósio's no-friction speed [m/s], >= 0.
         v1: Ambrósio's full-friction speed [m/s], > v0.
         min_approach_speed: floor on the recorded approach speed δ̇⁻ [m/s], > 0.
+        lubrication: the joint's oil film (`clearance.lubrication.Lubrication`), or None for a
+            dry joint; its force (`clearance.contact_calibration.film`) adds to the law's.
+        bearing_length: L [m] > 0, the film's length (required with ``lubrication``).
 
     Raises:
         ValueError: naming the joint, the attribute, its value and what was expected, for a
             missing site, sites on one body, a duplicate name, a non-finite or out-of-range
-            number, a law that is not a `ContactLaw`, a missing law parameter, or c_max/d_max
-            with a law other than IMPACT.
+            number, a law that is not a `ContactLaw`, a missing law parameter, c_max/d_max
+            with a law other than IMPACT, or a film without a bearing length or with a
+            transition thickness not below the clearance.
         clearance.contact_plugin.PluginUnavailableError: if the package was installed without
             the compiled plugin (checked after the attributes).
     """
@@ -249,6 +265,22 @@ def add_journal_bearing(
             f"law IMPACT only, not {law.name}; expected None"
         )
 
+    if lubrication is not None:
+        if not isinstance(lubrication, Lubrication):
+            raise TypeError(f"journal-bearing contact '{j}': lubrication must be a Lubrication (got {lubrication!r})")
+        if bearing_length is None:
+            raise ValueError(f"journal-bearing contact '{j}': a lubricated joint needs bearing_length [m]")
+        config["film"] = lubrication.film.value
+        config["viscosity"] = lubrication.viscosity
+        config["bearing_length"] = _number(j, "bearing_length", bearing_length, "> 0 [m]", lambda v: v > 0)
+        config["transition_thickness"] = _number(
+            j,
+            "transition_thickness",
+            lubrication.transition_thickness,
+            f"in (0, clearance = {config['clearance']}) [m]",
+            lambda v: 0 < v < config["clearance"],
+        )
+
     require()
     spec.activate_plugin(PLUGIN_NAME)
     plugin = spec.add_plugin(name=name, plugin_name=PLUGIN_NAME, active=True)
@@ -306,6 +338,8 @@ def add_for_clearance(
         v0=v0,
         v1=v1,
         min_approach_speed=min_approach_speed,
+        lubrication=clearance.lubrication,
+        bearing_length=clearance.bearing_length,
     )
 
 
@@ -324,7 +358,7 @@ def sensor_address(model: mujoco.MjModel, name: str) -> int:
         name: the contact's name (as given to `add_journal_bearing`).
 
     Returns:
-        The index of `SENSOR_FIELDS[0]`; the block is 8 values long.
+        The index of `SENSOR_FIELDS[0]`; the block is ``len(SENSOR_FIELDS)`` values long.
 
     Raises:
         ValueError: if the model has no such plugin sensor.
@@ -353,12 +387,12 @@ def sensor_offsets(model: mujoco.MjModel, name: str) -> dict[str, int]:
 
 
 def state_size(model: mujoco.MjModel) -> int:
-    """Values of one journal-bearing contact's state: `STATE_FIELDS`, then ``model.nv`` values.
+    """Values of one journal-bearing contact's state: `STATE_FIELDS`, then 2 ``model.nv`` values.
 
     Args:
         model: a compiled model.
     """
-    return len(STATE_FIELDS) + int(model.nv)
+    return len(STATE_FIELDS) + 2 * int(model.nv)
 
 
 def state_address(model: mujoco.MjModel, name: str) -> int:

@@ -90,14 +90,45 @@
 // inside the ramp instead of changing sign every step. RK4's states are synchronous and its
 // force explicit: it uses the sampled rates and velocities as they are.
 //
-// State (nstate = 9 + nv mjtNums per instance, part of mjSTATE_PLUGIN, so it travels with
+// Kinematic forcing. The sampled rate also changes, at constant generalized velocities, with the
+// geometry (the turning normal, the Jacobians' own rates: h J_dot v, the crank's centripetal
+// acceleration on a slider-crank). Over the step's velocity interval [t - h/2, t + h/2] that
+// change is a forcing of the rate ODE, and the rate at the interval's start is r0 - kin/2
+// (r0 itself is at t in its kinematic part): so the ODE of "Normal force" starts from
+// r0 - kin/2 and A gains kin/h. With small g the two cancel in the mean (the velocity part alone
+// is advanced, as above); with a large g (the oil film, a grazing dry contact) the rate then
+// settles on the lag the forcing needs instead of on h times it. kin is measured from the last
+// step: this step's sampled rate, less the last step's, less the last step's whole velocity
+// change along the row; at a step with no history, from the Jacobians' time derivatives
+// (mj_jacDot) at the state, the turning normal's share left out.
+//
+// Oil film. A lubricated joint (attribute film: short | long) adds the film force of
+// contact_calibration/film.py (film_scalar, operation by operation): with e seen from the
+// bearing, its rate v = (v_n, v_f) along (n, t) (v_f = t.(v_J - v_B) - |e| w_B) and the spin
+// w = w_J - w_B about z, F = F_0 - D v, F_0 = S w (-a_r n + a_t t), D = (S/c) [[b_r, -b_t],
+// [-b_t, g_t]] at eps = min(|e|/c, 1 - h_t/c) (the transition: below the film thickness h_t the
+// coefficients are held; the dry law acts on delta > 0 as without oil). F acts through the
+// journal's centre and -F through the bearing's, with the shear torques
+// T_J = -T_c - |e| F_t / 2 and T_B = T_c - |e| F_t / 2, T_c = 2 pi mu R^3 L w / (c sqrt(1 - eps^2)).
+// The film's damping is stiff (h w D reaches 1e3 near the transition at µs steps), so for the
+// semi-implicit integrators the normal rate and v_f are integrated together, the 2x2 form of
+// "Normal force": r = (r_n, r_f), r' = A - (1/h) G r, G = h W K, W the joint's own response on
+// the two rows, K = D + diag(C, 0) (C the dry law's damping), A the held forces' (F_0, -F_el,
+// the Couette torques', the last friction) plus the other forces' and the kinematic forcing;
+// the rates entering the forces are the exact means phi1(-G) r0 + h psi(G) A, computed through
+// the symmetric h L'W L (K = L L') whose eigenvalues are G's. The torques' own response and
+// the film's moment share are held over the step. RK4 evaluates the film at the state's rates.
+//
+// State (nstate = 11 + 2 nv mjtNums per instance, part of mjSTATE_PLUGIN, so it travels with
 // mj_getState/mj_setState and through mujoco.rollout chunks):
 //   [0] time of the last recorded sample [s]    [1] delta there [m]
 //   [2] normal rate at that sample's time [m/s] [3] friction force F_t applied there [N]
 //   [4] 1 once a sample is recorded, else 0     [5] 1 while in an impact, else 0
 //   [6] approach speed of that impact [m/s]     [7] dissipated work so far [J]
-//   [8] number of recorded steps                [9 .. 9 + nv) the last step's velocity change
+//   [8] number of recorded steps                [9] sampled normal rate there [m/s]
+//   [10] sampled film rate v_f there [m/s]      [11 .. 11 + nv) the last step's velocity change
 //                                                    from the other forces [m/s, rad/s]
+//   [11 + nv .. 11 + 2 nv) the last step's whole velocity change
 // The state is updated once per step, in `advance` (which MuJoCo calls once per mj_step, after
 // integration, whatever the integrator), from the force evaluation made at the step's start
 // state and the velocities the step ended with. Because `compute` runs several times per step
@@ -110,7 +141,7 @@
 // describes the old trajectory: reset it (mj_resetData, or zero the instance's plugin_state)
 // when doing so.
 //
-// Sensor output (nsensordata = 8), evaluated at the current state:
+// Sensor output (nsensordata = 10), evaluated at the current state:
 //   [0] F_n normal force [N] (>= 0)   [1] F_t tangential force on the journal along t [N]
 //   [2] delta penetration [m]         [3] delta_dot entering the law [m/s] (> 0 approaching)
 //   [4] v_in approach speed [m/s] (0 out of contact)
@@ -119,6 +150,9 @@
 //       step in `advance` as timestep * power of the applied force: (F_n - F_el) rate - F_t v_t,
 //       v_t the mean of the step's start and end tangential velocities)
 //   [7] |e| eccentricity magnitude [m]
+//   [8] film force on the journal along n [N] (negative: towards the centre; 0 without oil)
+//   [9] film force on the journal along t [N]
+// (with a film, [6] also holds the film's dissipation: minus its power on the two bodies)
 //
 // Config attributes (strings; validated in Python before compiling, re-checked here):
 //   journal_site, bearing_site  site names
@@ -131,6 +165,8 @@
 //   c_max [N s/m] >= 0, d_max [m] > 0: impact law only
 //   friction mu >= 0 (default 0), v0 [m/s] (default 1e-4), v1 [m/s] (default 1e-3), 0 <= v0 < v1
 //   min_approach_speed [m/s] > 0 (default 1e-3, laws.MIN_APPROACH_SPEED)
+//   film: none (default) | short | long; with a film: viscosity mu [Pa s] > 0,
+//        bearing_length L [m] > 0, transition_thickness h_t [m] in (0, c)
 
 #include <math.h>
 #include <stdint.h>
@@ -141,20 +177,23 @@
 #include <mujoco/mujoco.h>
 
 #include "contact_laws.h"
+#include "film.h"
 #include "plugin_util.h"
 
 #define JB_NAME "clearance.journal_bearing"
-#define JB_NSENSOR 8
+#define JB_NSENSOR 10
 
-// state layout of a journal bearing (B_OTHER: nv values)
+// state layout of a journal bearing (B_OTHER and B_DV: nv values each, B_DV = B_OTHER + nv)
 enum {
-  B_TIME = 0, B_DELTA, B_RATE, B_FT, B_HAVE, B_CONTACT, B_VIN, B_WORK, B_NSTEP, B_OTHER
+  B_TIME = 0, B_DELTA, B_RATE, B_FT, B_HAVE, B_CONTACT, B_VIN, B_WORK, B_NSTEP, B_RATE0,
+  B_RATEF0, B_OTHER
 };
 
 
 static const char* const kAttributes[] = {
   "journal_site", "bearing_site", "clearance", "journal_radius", "law", "stiffness",
-  "exponent", "restitution", "c_max", "d_max", "friction", "v0", "v1", "min_approach_speed"
+  "exponent", "restitution", "c_max", "d_max", "friction", "v0", "v1", "min_approach_speed",
+  "film", "viscosity", "bearing_length", "transition_thickness"
 };
 
 // one force evaluation
@@ -165,6 +204,7 @@ typedef struct {
   mjtNum rate_geo;   // geometric penetration rate [m/s]
   mjtNum rate;       // rate entering the law [m/s]
   mjtNum vt_geo;     // geometric tangential velocity [m/s]
+  mjtNum vtf_geo;    // film: e's sampled tangential rate seen from the bearing [m/s]
   mjtNum vin;        // approach speed [m/s] (0 out of contact)
   mjtNum fn;         // normal force [N]
   mjtNum ft;         // tangential force [N]
@@ -175,6 +215,11 @@ typedef struct {
   mjtNum tangent[3];  // t = z x n (world)
   mjtNum pj[3];      // contact point on the journal (world)
   mjtNum pb[3];      // contact point on the bearing (world)
+  mjtNum film_n;     // film force on the journal along n [N] (negative: pushes it back)
+  mjtNum film_t;     // film force on the journal along t [N]
+  mjtNum torque_j;   // film shear torque on the journal about z [N m]
+  mjtNum torque_b;   // film shear torque on the bearing about z [N m]
+  mjtNum axis[3];    // z, the joint's axis (world)
 } jbEval;
 
 // parsed configuration and per-mjData scratch, in d->plugin_data[instance]
@@ -183,13 +228,14 @@ typedef struct {
   int journal_body, bearing_body;
   mjtNum clearance, journal_radius;
   clLaw lw;                  // the normal law
+  clFilm film;               // the oil film (film.model FILM_NONE: a dry joint)
   mjtNum friction, v0, v1;
   mjtNum min_speed;
   int nsensor;
   int* sensor_adr;           // sensordata addresses of this instance's sensors
   jbEval cache[CL_NCACHE];   // passive evaluations since the last advance
   int cache_next;            // round-robin slot
-  // in-step treatment (semi-implicit integrators), one block of 17 + 3 CL_NCACHE times nv values
+  // in-step treatment (semi-implicit integrators), one block of 22 + 3 CL_NCACHE times nv values
   // allocated in init (vec_t follows vec_n, ut follows un: each pair is solved in one call):
   mjtNum* vec_n;             // row of the normal rate over the dofs (nv)
   mjtNum* vec_t;             // row of the tangential velocity (nv)
@@ -197,6 +243,11 @@ typedef struct {
   mjtNum* ut;                // M^-1 vec_t' (nv)
   mjtNum* own;               // this joint's velocity change over the step, h M^-1 J' f (nv)
   mjtNum* scratch;           // two bodies' Jacobians (12 nv)
+  mjtNum* vec_tf;            // film: row of the tangential rate of e seen from the bearing (nv)
+  mjtNum* u_tf;              // film: M^-1 vec_tf' (nv)
+  mjtNum* vec_rj;            // film: row of the journal's angular velocity about z (nv)
+  mjtNum* vec_rb;            // film: row of the bearing's angular velocity about z (nv)
+  mjtNum* own_film;          // film: its generalized force, then h M^-1 of it (nv)
   mjtNum* slot_vec;          // per cache slot: qvel, own and vec_n at the evaluation (3 nv each)
   // the equality constraints' rows, at most eq_max of them (allocated in init)
   int eq_max;
@@ -228,7 +279,8 @@ static int configure(const mjModel* m, int instance, jbData* c) {
       !cl_check(m, c->clearance > 0, instance, "clearance", c->clearance, "> 0 [m]") ||
       !cl_read_number(m, instance, "journal_radius", NULL, &c->journal_radius) ||
       !cl_check(m, c->journal_radius > 0, instance, "journal_radius", c->journal_radius, "> 0 [m]") ||
-      !cl_configure_law(m, instance, &c->lw)) {
+      !cl_configure_law(m, instance, &c->lw) ||
+      !cl_configure_film(m, instance, c->clearance, c->journal_radius, &c->film)) {
     return 0;
   }
 
@@ -286,9 +338,9 @@ static mjtNum implicit_sliding_velocity(const jbData* c, mjtNum v_free, mjtNum k
 //   J_n = n' (Jp_J(p_J) - Jp_B(p_B))
 //   J_t = t' (Jp_J(p_J) - Jp_B(p_B)) + R_J z' Jr_J - (R_J + c) z' Jr_B
 // (the contact points sit at R_J n and (R_J + c) n from the centres, and t' (w x r n) = r z' w);
-// scratch: 12 nv
-static void contact_rows(const mjModel* m, const mjData* d, const jbData* c, const mjtNum n[3],
-                         const mjtNum t[3], const mjtNum z[3], mjtNum* jn, mjtNum* jt,
+// with a film also its rows (vec_tf, vec_rj, vec_rb: see "Oil film"); scratch: 12 nv
+static void contact_rows(const mjModel* m, const mjData* d, jbData* c, const mjtNum n[3],
+                         const mjtNum t[3], const mjtNum z[3], mjtNum ecc, mjtNum* jn, mjtNum* jt,
                          mjtNum* scratch) {
   int nv = m->nv;
   mjtNum *pj = scratch, *rj = scratch + 3 * nv, *pb = scratch + 6 * nv, *rb = scratch + 9 * nv;
@@ -301,6 +353,14 @@ static void contact_rows(const mjModel* m, const mjData* d, const jbData* c, con
     jt[i] = t[0] * dx + t[1] * dy + t[2] * dzz +
             arm_j * (z[0] * rj[i] + z[1] * rj[nv + i] + z[2] * rj[2 * nv + i]) -
             arm_b * (z[0] * rb[i] + z[1] * rb[nv + i] + z[2] * rb[2 * nv + i]);
+  }
+  if (c->film.model != FILM_NONE) {  // the film's rows: e's tangential rate seen from the
+    for (int i = 0; i < nv; i++) {   // bearing, t'(v_J - v_B) - |e| w_B, and the two spins
+      mjtNum dx = pj[i] - pb[i], dy = pj[nv + i] - pb[nv + i], dzz = pj[2 * nv + i] - pb[2 * nv + i];
+      c->vec_rj[i] = z[0] * rj[i] + z[1] * rj[nv + i] + z[2] * rj[2 * nv + i];
+      c->vec_rb[i] = z[0] * rb[i] + z[1] * rb[nv + i] + z[2] * rb[2 * nv + i];
+      c->vec_tf[i] = t[0] * dx + t[1] * dy + t[2] * dzz - ecc * c->vec_rb[i];
+    }
   }
 }
 
@@ -318,18 +378,17 @@ static int equality_rows_max(const mjModel* m) {
   return n;
 }
 
-// Turn the free responses M^-1 J_n' and M^-1 J_t' (in c->un, c->ut) into the responses with the
-// equality constraints' rows acting as the constraint solver solves them alone (their soft
-// dynamics at this state): u -= Y (J_c M^-1 J_c' + R)^-1 J_c u, Y = M^-1 J_c'. A loop closure
-// or a pin held by a connect then moves as the loop lets it, not as the free tree would.
-static void constrained_responses(const mjModel* m, mjData* d, jbData* c) {
+// The equality constraints' rows at this state and the Cholesky factor of J_c M^-1 J_c' + R
+// (kept in c); returns their count k, or 0 (none, more than the model declares, or singular:
+// the responses stay free). See `constrain`.
+static int equality_factor(const mjModel* m, mjData* d, jbData* c) {
   int nv = m->nv, k = 0;
   if (c->eq_max <= 0) {
-    return;
+    return 0;
   }
   for (int r = 0; r < d->nefc; r++) {
     if (d->efc_type[r] != mjCNSTR_EQUALITY) continue;
-    if (k == c->eq_max) return;  // more rows than the model declares: keep the free response
+    if (k == c->eq_max) return 0;  // more rows than the model declares: keep the free response
     mjtNum* row = c->eq_rows + k * nv;
     if (mj_isSparse(m)) {
       mju_zero(row, nv);
@@ -344,7 +403,7 @@ static void constrained_responses(const mjModel* m, mjData* d, jbData* c) {
     k++;
   }
   if (k == 0) {
-    return;
+    return 0;
   }
   mj_solveM(m, d, c->eq_y, c->eq_rows, k);
   for (int i = 0; i < k; i++) {
@@ -355,20 +414,22 @@ static void constrained_responses(const mjModel* m, mjData* d, jbData* c) {
     }
     c->eq_a[i * k + i] += c->eq_z[i];
   }
-  if (mju_cholFactor(c->eq_a, k, mjMINVAL) < k) {
-    return;  // singular: keep the free response
+  return mju_cholFactor(c->eq_a, k, mjMINVAL) < k ? 0 : k;  // singular: keep the free response
+}
+
+// Turn a free response u = M^-1 f (f a row or a generalized force) into the response with the
+// equality constraints' rows acting as the constraint solver solves them alone (their soft
+// dynamics at this state): u -= Y (J_c M^-1 J_c' + R)^-1 J_c u, Y = M^-1 J_c'. A loop closure
+// or a pin held by a connect then moves as the loop lets it, not as the free tree would.
+static void constrain(const jbData* c, int k, int nv, mjtNum* u) {
+  mjtNum* b = c->eq_z;
+  mjtNum* z = c->eq_z + c->eq_max;
+  for (int i = 0; i < k; i++) {
+    b[i] = mju_dot(c->eq_rows + i * nv, u, nv);
   }
-  mjtNum* u[2] = {c->un, c->ut};
-  for (int v = 0; v < 2; v++) {
-    mjtNum* b = c->eq_z;
-    mjtNum* z = c->eq_z + c->eq_max;
-    for (int i = 0; i < k; i++) {
-      b[i] = mju_dot(c->eq_rows + i * nv, u[v], nv);
-    }
-    mju_cholSolve(z, c->eq_a, b, k);
-    for (int i = 0; i < k; i++) {
-      mju_addToScl(u[v], c->eq_y + i * nv, -z[i], nv);
-    }
+  mju_cholSolve(z, c->eq_a, b, k);
+  for (int i = 0; i < k; i++) {
+    mju_addToScl(u, c->eq_y + i * nv, -z[i], nv);
   }
 }
 
@@ -433,20 +494,57 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
   // last step's velocity change from every other force (state), projected on the rows.
   int instep = cl_semi_implicit(m);
   int last = cl_is_last_step(m, d, s[B_HAVE], s[B_TIME]);
+  int film = c->film.model != FILM_NONE;
   mjtNum w_nn = 0, w_nt = 0, w_tt = 0, other_n = 0, other_t = 0;
+  mjtNum w_nf = 0, w_ff = 0, w_tf = 0, other_f = 0;  // the film's tangential row (f)
   mjtNum* jn = c->vec_n;
   mjtNum* jt = c->vec_t;
+  int neq = 0;
   if (instep) {
-    contact_rows(m, d, c, n, ev->tangent, z, jn, jt, c->scratch);
+    contact_rows(m, d, c, n, ev->tangent, z, ecc, jn, jt, c->scratch);
     mj_solveM(m, d, c->un, jn, 2);  // un, ut: the two rows stored one after the other
-    constrained_responses(m, d, c);
+    neq = equality_factor(m, d, c);
+    if (neq) {
+      constrain(c, neq, nv, c->un);
+      constrain(c, neq, nv, c->ut);
+    }
     w_nn = mju_dot(jn, c->un, nv);
     w_nt = mju_dot(jn, c->ut, nv);
     w_tt = mju_dot(jt, c->ut, nv);
+    if (film) {
+      mj_solveM(m, d, c->u_tf, c->vec_tf, 1);
+      if (neq) constrain(c, neq, nv, c->u_tf);
+      w_nf = mju_dot(jn, c->u_tf, nv);
+      w_ff = mju_dot(c->vec_tf, c->u_tf, nv);
+      w_tf = mju_dot(jt, c->u_tf, nv);
+    }
     if (last) {
       other_n = mju_dot(jn, s + B_OTHER, nv);
       other_t = mju_dot(jt, s + B_OTHER, nv);
+      if (film) other_f = mju_dot(c->vec_tf, s + B_OTHER, nv);
     }
+  }
+
+  // the sampled rate's change over the last step from the geometry alone (the turning normal and
+  // Jacobian at the last step's velocities: h J_dot v): this step's sampled rate, less the last
+  // step's, less the last step's whole velocity change along the row ("Kinematic forcing")
+  mjtNum kin_n = instep && last ? rate_geo - s[B_RATE0] - mju_dot(jn, s + B_OTHER + nv, nv) : 0.0;
+  mjtNum kin_f_start = 0;  // the film row's, at a step with no history (below)
+  if (instep && !last) {
+    // no history (a run's first step, a state set by hand): the Jacobians' own rates at the
+    // state, h n'(Jdot_J - Jdot_B) v (the turning normal's share, |e_dot_t|^2/|e|, left out)
+    mjtNum *dj = c->scratch, *djr = c->scratch + 3 * nv, *db = c->scratch + 6 * nv,
+           *dbr = c->scratch + 9 * nv;
+    mj_jacDot(m, d, dj, djr, pj, c->journal_body);
+    mj_jacDot(m, d, db, dbr, pb, c->bearing_body);
+    mjtNum an3[3] = {0, 0, 0}, ab3[3] = {0, 0, 0}, wb = 0;
+    for (int k = 0; k < 3; k++) {
+      an3[k] = mju_dot(dj + k * nv, d->qvel, nv) - mju_dot(db + k * nv, d->qvel, nv);
+      ab3[k] = mju_dot(dbr + k * nv, d->qvel, nv);
+    }
+    wb = mju_dot3(ab3, z);
+    kin_n = h * mju_dot3(n, an3);
+    kin_f_start = h * (mju_dot3(ev->tangent, an3) - ecc * wb);
   }
 
   // the rate at the step's time with no force of this joint: the sampled rate (half a step
@@ -467,27 +565,96 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
     vin = vin > c->min_speed ? vin : c->min_speed;
   }
 
+  // the film's coefficients at the clamped eccentricity ratio, its held part F_0 and damping D
+  // (in the directions n and t), and its rates at the state: e's rate seen from the bearing
+  // (the normal one is rate_geo) and the spin of the journal relative to the bearing
+  mjtNum kf[5] = {0, 0, 0, 0, 0}, f0n = 0, f0t = 0, dnn = 0, dnt = 0, dtt = 0;
+  mjtNum vtf_geo = 0, spin = 0, ratio = 0, kin_f = 0;
+  if (film) {
+    spin = mju_dot3(vj, z) - mju_dot3(vb, z);  // the sites' angular velocities
+    vtf_geo = mju_dot3(ev->tangent, vrel) - ecc * mju_dot3(vb, z);
+    if (instep) {
+      kin_f = last ? vtf_geo - s[B_RATEF0] - mju_dot(c->vec_tf, s + B_OTHER + nv, nv) : kin_f_start;
+    }
+    ratio = mju_min(ecc / c->film.clearance, c->film.ratio_max);
+    cl_film_terms(c->film.model, ratio, kf);
+    mjtNum sc = c->film.scale, g = c->film.scale / c->film.clearance;
+    f0n = -sc * kf[0] * spin;
+    f0t = sc * kf[2] * spin;
+    dnn = g * kf[1];
+    dnt = -g * kf[3];
+    dtt = g * kf[4];
+  }
+
   // the rate entering the law: the mean over the step of the normal rate's velocity part,
-  // with this joint's damping integrated exponentially and its elastic force held
-  mjtNum rate = rate_geo, fel = 0;
+  // with this joint's damping integrated exponentially and its elastic force held; with a film,
+  // the normal and the film's tangential rate together (the 2x2 form of "Oil film")
+  mjtNum rate = rate_geo, rate_f = vtf_geo, fel = 0;
   if (delta > 0) {
     fel = c->lw.stiffness * pow(delta, c->lw.exponent);
   }
   if (instep) {
     mjtNum ft_last = last ? s[B_FT] : 0.0;
-    mjtNum g = delta > 0 ? h * w_nn * cl_law_damping(&c->lw, delta, fel, vin) : 0.0;
-    mjtNum phi1, psi;
-    cl_exponential_means(g, &phi1, &psi);
-    rate = rate_geo * phi1 + (other_n - h * w_nn * fel + h * w_nt * ft_last) * psi;
+    mjtNum cd = delta > 0 ? cl_law_damping(&c->lw, delta, fel, vin) : 0.0;
+    if (!film) {
+      mjtNum phi1, psi;
+      cl_exponential_means(h * w_nn * cd, &phi1, &psi);
+      rate = (rate_geo - 0.5 * kin_n) * phi1 + (other_n + kin_n - h * w_nn * fel + h * w_nt * ft_last) * psi;
+    } else {
+      // held forces on the journal along (n, f): -F_el + F_0n, F_0t; damping K = D + diag(C, 0);
+      // the Couette torques (held) move the rates too: their response through W on the rows
+      mjtNum hn = -fel + f0n, ht = f0t;
+      mjtNum W[4] = {w_nn, w_nf, w_nf, w_ff};
+      mjtNum K[4] = {dnn + cd, dnt, dnt, dtt};
+      mjtNum couette = c->film.couette * spin / sqrt(1.0 - ratio * ratio);
+      mjtNum* torque = c->scratch;
+      for (int i = 0; i < nv; i++) {
+        torque[i] = couette * (c->vec_rb[i] - c->vec_rj[i]);
+      }
+      mj_solveM(m, d, c->own_film, torque, 1);
+      if (neq) constrain(c, neq, nv, c->own_film);
+      mjtNum an = other_n + kin_n + h * (w_nn * hn + w_nf * ht + w_nt * ft_last + mju_dot(jn, c->own_film, nv));
+      mjtNum af = other_f + kin_f +
+                  h * (w_nf * hn + w_ff * ht + w_tf * ft_last + mju_dot(c->vec_tf, c->own_film, nv));
+      mjtNum Phi[4], Psi[4];
+      cl_exponential_means2(h, W, K, Phi, Psi);
+      mjtNum r0 = rate_geo - 0.5 * kin_n, f0 = vtf_geo - 0.5 * kin_f;  // at the step's start
+      rate = Phi[0] * r0 + Phi[1] * f0 + Psi[0] * an + Psi[1] * af;
+      rate_f = Phi[2] * r0 + Phi[3] * f0 + Psi[2] * an + Psi[3] * af;
+    }
   }
   mjtNum fn = cl_normal_force(&c->lw, delta, rate, vin, &fel);
+
+  // the film's force at the rates (F_0 - D rate) and its shear torques
+  mjtNum ffn = 0, fft = 0, tj = 0, tb = 0, film_power = 0;
+  if (film) {
+    ffn = f0n - (dnn * rate + dnt * rate_f);
+    fft = f0t - (dnt * rate + dtt * rate_f);
+    mjtNum couette = c->film.couette * spin / sqrt(1.0 - ratio * ratio);
+    mjtNum moment = ecc * fft;  // e x F about z
+    tj = -couette - 0.5 * moment;
+    tb = couette - 0.5 * moment;
+    // power of the film on the two bodies (the fluid takes no energy): F.e_dot + T_J w_J +
+    // T_B w_B = F_n rate + F_t rate_f - couette spin - moment spin / 2, at the step's mean rates
+    film_power = ffn * rate + fft * rate_f - couette * spin - 0.5 * moment * spin;
+    if (instep) {  // its generalized force, then h M^-1 of it
+      mjtNum* force = c->scratch;  // free again once the rows are made
+      for (int i = 0; i < nv; i++) {
+        force[i] = ffn * jn[i] + fft * (c->vec_tf[i] + ecc * c->vec_rb[i]) +
+                   tj * c->vec_rj[i] + tb * c->vec_rb[i];
+      }
+      mj_solveM(m, d, c->own_film, force, 1);
+      if (neq) constrain(c, neq, nv, c->own_film);
+      mju_scl(c->own_film, c->own_film, h, nv);
+    }
+  }
 
   // friction at the tangential velocity it leaves at the step's end (semi-implicit), or at
   // the sampled one (RK4)
   mjtNum vt = vt_geo, ft = 0;
   if (c->friction != 0 && fn > 0) {
     if (instep) {
-      mjtNum v_free = vt_geo + other_t - h * w_nt * fn;
+      mjtNum v_free = vt_geo + other_t - h * w_nt * fn + (film ? mju_dot(jt, c->own_film, nv) : 0.0);
       mjtNum v_end = implicit_sliding_velocity(c, v_free, h * w_tt * c->friction * fn);
       ft = friction_force(c, fn, v_end);
       vt = 0.5 * (vt_geo + v_end);
@@ -498,7 +665,7 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
 
   if (instep) {  // this joint's own velocity change over the step, h M^-1 J' f
     for (int i = 0; i < nv; i++) {
-      c->own[i] = h * (ft * c->ut[i] - fn * c->un[i]);
+      c->own[i] = h * (ft * c->ut[i] - fn * c->un[i]) + (film ? c->own_film[i] : 0.0);
     }
   }
 
@@ -508,28 +675,50 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
   ev->rate_geo = rate_geo;
   ev->rate = rate;
   ev->vt_geo = vt_geo;
+  ev->vtf_geo = vtf_geo;
   ev->vin = vin;
   ev->fn = fn;
   ev->ft = ft;
   ev->fel = fel;
   ev->ecc = ecc;
-  ev->power = delta > 0 ? (fn - fel) * rate - ft * vt : 0.0;
+  ev->film_n = ffn;
+  ev->film_t = fft;
+  ev->torque_j = tj;
+  ev->torque_b = tb;
+  mju_copy3(ev->axis, z);
+  ev->power = (delta > 0 ? (fn - fel) * rate - ft * vt : 0.0) - film_power;
 }
 
-// add the contact force to qfrc_passive: f on the journal at P_J, -f on the bearing at P_B
+// add the contact force to qfrc_passive: f on the journal at P_J, -f on the bearing at P_B; a
+// film's force through the two centres and its shear torques
 static void apply(const mjModel* m, mjData* d, const jbData* c, const jbEval* ev) {
-  if (ev->fn == 0 && ev->ft == 0) {
-    return;
+  if (ev->fn != 0 || ev->ft != 0) {
+    mjtNum f[3], g[3];
+    mju_scl3(f, ev->normal, -ev->fn);
+    mju_addToScl3(f, ev->tangent, ev->ft);
+    mju_scl3(g, f, -1.0);
+    if (c->journal_body) {
+      mj_applyFT(m, d, f, NULL, ev->pj, c->journal_body, d->qfrc_passive);
+    }
+    if (c->bearing_body) {
+      mj_applyFT(m, d, g, NULL, ev->pb, c->bearing_body, d->qfrc_passive);
+    }
   }
-  mjtNum f[3], g[3];
-  mju_scl3(f, ev->normal, -ev->fn);
-  mju_addToScl3(f, ev->tangent, ev->ft);
-  mju_scl3(g, f, -1.0);
-  if (c->journal_body) {
-    mj_applyFT(m, d, f, NULL, ev->pj, c->journal_body, d->qfrc_passive);
-  }
-  if (c->bearing_body) {
-    mj_applyFT(m, d, g, NULL, ev->pb, c->bearing_body, d->qfrc_passive);
+  if (c->film.model != FILM_NONE) {
+    mjtNum f[3], g[3], tj[3], tb[3];
+    mju_scl3(f, ev->normal, ev->film_n);
+    mju_addToScl3(f, ev->tangent, ev->film_t);
+    mju_scl3(g, f, -1.0);
+    mju_scl3(tj, ev->axis, ev->torque_j);
+    mju_scl3(tb, ev->axis, ev->torque_b);
+    if (c->journal_body) {
+      mj_applyFT(m, d, f, tj, d->site_xpos + 3 * c->journal_site, c->journal_body,
+                 d->qfrc_passive);
+    }
+    if (c->bearing_body) {
+      mj_applyFT(m, d, g, tb, d->site_xpos + 3 * c->bearing_site, c->bearing_body,
+                 d->qfrc_passive);
+    }
   }
 }
 
@@ -588,7 +777,7 @@ static int same_state_slot(const mjModel* m, const mjData* d, const jbData* c) {
 }
 
 static int jb_nstate(const mjModel* m, int instance) {
-  return B_OTHER + m->nv;
+  return B_OTHER + 2 * m->nv;
 }
 
 
@@ -615,7 +804,7 @@ static int jb_init(const mjModel* m, mjData* d, int instance) {
   }
   c->sensor_adr = cl_instance_sensors(m, instance, &c->nsensor);
   int nv = m->nv > 0 ? m->nv : 1;
-  c->vec_n = (mjtNum*)calloc((size_t)(17 + 3 * CL_NCACHE) * nv, sizeof(mjtNum));
+  c->vec_n = (mjtNum*)calloc((size_t)(22 + 3 * CL_NCACHE) * nv, sizeof(mjtNum));
   if (!c->sensor_adr || !c->vec_n) {
     jb_free(c);
     mju_warning(JB_NAME " instance %d: out of memory", instance);
@@ -626,7 +815,12 @@ static int jb_init(const mjModel* m, mjData* d, int instance) {
   c->ut = c->vec_n + 3 * nv;
   c->own = c->vec_n + 4 * nv;
   c->scratch = c->vec_n + 5 * nv;
-  c->slot_vec = c->vec_n + 17 * nv;
+  c->vec_tf = c->vec_n + 17 * nv;
+  c->u_tf = c->vec_n + 18 * nv;
+  c->vec_rj = c->vec_n + 19 * nv;
+  c->vec_rb = c->vec_n + 20 * nv;
+  c->own_film = c->vec_n + 21 * nv;
+  c->slot_vec = c->vec_n + 22 * nv;
   c->eq_max = equality_rows_max(m);
   if (c->eq_max > 0) {
     int k = c->eq_max;
@@ -663,7 +857,7 @@ static void jb_copy(mjData* dest, const mjModel* m, const mjData* src, int insta
 }
 
 static void jb_reset(const mjModel* m, mjtNum* plugin_state, void* plugin_data, int instance) {
-  mju_zero(plugin_state, B_OTHER + m->nv);
+  mju_zero(plugin_state, B_OTHER + 2 * m->nv);
   if (plugin_data) {
     clear_cache((jbData*)plugin_data);
   }
@@ -689,7 +883,7 @@ static void jb_compute(const mjModel* m, mjData* d, int instance, int capability
     mjtNum out[JB_NSENSOR] = {
       ev.fn, ev.ft, ev.delta, ev.rate, ev.vin,
       ev.delta > 0 ? ev.fel * ev.delta / (c->lw.exponent + 1) : 0.0,
-      s[B_WORK], ev.ecc
+      s[B_WORK], ev.ecc, ev.film_n, ev.film_t
     };
     for (int i = 0; i < c->nsensor; i++) {
       mju_copy(d->sensordata + c->sensor_adr[i], out, JB_NSENSOR);
@@ -712,6 +906,8 @@ static void jb_advance(const mjModel* m, mjData* d, int instance) {
     s[B_DELTA] = ev->delta;
     s[B_FT] = ev->ft;
     s[B_RATE] = ev->rate_geo;
+    s[B_RATE0] = ev->rate_geo;
+    s[B_RATEF0] = ev->vtf_geo;
     if (cl_semi_implicit(m)) {
       // the step's velocity change: what this joint's force did, the rest (other forces),
       // and the rate at the evaluation's time (the mean of the step's start and end rates)
@@ -721,6 +917,7 @@ static void jb_advance(const mjModel* m, mjData* d, int instance) {
       for (int i = 0; i < nv; i++) {
         mjtNum dv = d->qvel[i] - v[i];
         s[B_OTHER + i] = dv - v[nv + i];
+        s[B_OTHER + nv + i] = dv;
         half += v[2 * nv + i] * dv;
       }
       s[B_RATE] += 0.5 * half;

@@ -99,6 +99,8 @@ def test_in_step_treatment_equals_its_formula(integrator: mujoco.mjtIntegrator |
         state[adr + S["approach_speed"]] = vin = rng.uniform(1e-3, 2.0)
         state[adr + S["sample_friction_force"]] = ft_last = rng.uniform(-50, 50)
         state[other : other + 6] = dv = rng.uniform(-1, 1, 6) * 1e-4
+        state[other + 6 : other + 12] = dv_all = dv + rng.uniform(-1, 1, 6) * 1e-4
+        state[adr + S["sample_geometric_rate"]] = rate0 = rng.uniform(-1, 1)
         mujoco.mj_forward(model, data)
         fields = ("normal_force", "tangential_force", "penetration", "penetration_rate")
         fn, ft, d, rate = (data.sensordata[y[k]] for k in fields)
@@ -109,7 +111,11 @@ def test_in_step_treatment_equals_its_formula(integrator: mujoco.mjtIntegrator |
         fel = K * d**1.5
         g = h * w_nn * fel * laws.hysteresis_factor(LN, 0.9) / vin
         phi1, psi = -np.expm1(-g) / g, (g + np.expm1(-g)) / g**2
-        expected_rate = (jn @ data.qvel) * phi1 + (jn @ dv - h * w_nn * fel + h * w_nt * ft_last) * psi
+        # the geometry's own change of the sampled rate over the last step (h J_dot v): the rate's
+        # change less the whole velocity change along the row; it forces the step's rate
+        r0 = jn @ data.qvel
+        kin = r0 - rate0 - jn @ dv_all
+        expected_rate = (r0 - kin / 2) * phi1 + (jn @ dv + kin - h * w_nn * fel + h * w_nt * ft_last) * psi
         # the same operations in another order (and the series below g = 1e-3 in C): 1e-9 of the
         # rate's largest term, |jn . qvel| ~ 1 m/s, bounds the rounding of psi's cancellation
         assert rate == pytest.approx(expected_rate, abs=1e-9)

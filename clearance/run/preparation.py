@@ -106,24 +106,20 @@ def _cycle_times(mechanism: Mechanism, n: int = 181) -> np.ndarray:
 
 
 def _refuse_lubricated(mechanism: Mechanism, mode: ContactMode) -> None:
-    """Refuse a lubricated joint, with the reason, in a mode that cannot carry its film.
+    """Refuse a lubricated joint, with the reason, in a mode that cannot carry its film (the rings).
 
     Raises:
-        ValueError: a clearance joint of the mechanism carries a `Lubrication`.
+        ValueError: a clearance joint of the mechanism carries a `Lubrication` and ``mode`` is a
+            ring mode.
     """
     oiled = [j.name for j in mechanism.clearance_joints if j.require_clearance().lubrication is not None]
-    if not oiled:
+    if not oiled or mode is ContactMode.EXACT:
         return
-    if mode is ContactMode.EXACT:
-        why = "the compiled contact does not carry the film yet"
-    else:
-        why = (
-            f"contact mode '{mode.value}' (the ring of contact segments) cannot carry it: ring contacts push only "
-            "where a segment touches the journal, while the film pushes across the whole clearance from the "
-            "journal's speed"
-        )
     raise ValueError(
-        f"joint(s) {oiled} are lubricated and {why}; run them with the reference solver (clearance reference)"
+        f"joint(s) {oiled} are lubricated and contact mode '{mode.value}' (the ring of contact segments) cannot "
+        "carry the film: ring contacts push only where a segment touches the journal, while the film pushes "
+        "across the whole clearance from the journal's speed; run them with contact_mode 'exact' or the "
+        "reference solver (clearance reference)"
     )
 
 

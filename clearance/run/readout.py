@@ -41,13 +41,15 @@ def _exact_contact_force(sens: np.ndarray, at: dict[str, int], e: np.ndarray) ->
     """Contact force on the journal [N], (n, 2) in the bearing frame, as the ring's contact sensor gives it.
 
     The plugin gives the normal force F_n >= 0 and the tangential force F_t on the journal
-    along t = z x n, n = e/|e|: the force on the journal is -F_n n + F_t t.
+    along t = z x n, n = e/|e|: the force on the journal is -F_n n + F_t t, plus a lubricated
+    joint's film force (its components along n and t; 0 for a dry joint).
     """
     r = np.hypot(e[:, 0], e[:, 1])
     safe = np.where(r > 0, r, 1.0)
     n = np.where(r[:, None] > 0, e / safe[:, None], np.array([1.0, 0.0]))
     t = np.stack([-n[:, 1], n[:, 0]], axis=1)
-    fn, ft = sens[:, at["normal_force"]], sens[:, at["tangential_force"]]
+    fn = sens[:, at["normal_force"]] - sens[:, at["film_normal_force"]]
+    ft = sens[:, at["tangential_force"]] + sens[:, at["film_tangential_force"]]
     return -fn[:, None] * n + ft[:, None] * t
 
 

@@ -277,7 +277,14 @@ def start_data(model: mujoco.MjModel, qpos0: np.ndarray | None = None) -> mujoco
         data.qpos[:] = qpos0
     if model.opt.integrator == mujoco.mjtIntegrator.mjINT_RK4:
         return data
-    mujoco.mj_forward(model, data)
+    # a0 with every force at the state's own rates: RK4's evaluation (the compiled contacts'
+    # in-step treatment would give the mean over the coming step instead)
+    integrator = model.opt.integrator
+    model.opt.integrator = mujoco.mjtIntegrator.mjINT_RK4
+    try:
+        mujoco.mj_forward(model, data)
+    finally:
+        model.opt.integrator = integrator
     v = data.qvel - 0.5 * model.opt.timestep * data.qacc
     rows = _equality_rows(model, data)
     if len(rows):
@@ -388,8 +395,9 @@ def _finish(
         "links": [lk.name for lk in mech.moving_links],
         "steps": nstep_done,
         "output_every_steps": every,
-        "wall_time_s": wall,
-        "steps_per_second": nstep_done / wall if wall > 0 else None,
+        # 4 significant digits: a wall time is measured to a millisecond or so, not to 1e-17 s
+        "wall_time_s": float(f"{wall:.4g}"),
+        "steps_per_second": float(f"{nstep_done / wall:.4g}") if wall > 0 else None,
         "mujoco_version": mujoco.__version__,
         "package_version": __version__,
     }
@@ -449,9 +457,9 @@ def _progress(progress: bool | Callable[[float], None], total: int) -> Callable[
         return lambda done: progress(1.0 if done is None else done / total)
     if not progress:
         return lambda done: None
-    from tqdm import tqdm
+    from clearance.progress import progress_bar
 
-    bar = tqdm(total=total, unit="step", unit_scale=True, desc="simulate", leave=False)
+    bar = progress_bar(total, unit="step", desc="simulate", unit_scale=True, leave=False)
 
     def update(done: int | None) -> None:
         if done is None:
