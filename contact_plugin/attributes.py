@@ -38,9 +38,10 @@ from typing import Any
 import mujoco
 
 from clearance.contact_calibration import laws
+from clearance.contact_calibration.cylindrical_laws import CylinderLaw, cylinder_law
 from clearance.contact_plugin import PLUGIN_NAME, require
 from clearance.lubrication import Lubrication
-from clearance.model import Clearance, ContactLaw
+from clearance.model import CYLINDRICAL_LAWS, Clearance, ContactLaw
 
 __all__ = [
     "COMPILED_LAWS",
@@ -86,18 +87,10 @@ STATE_FIELDS: tuple[str, ...] = (
 more follow (`state_size`): the last step's velocity change from every force but the joint's
 own, then its whole velocity change."""
 
-COMPILED_LAWS: tuple[ContactLaw, ...] = (
-    ContactLaw.HERTZ,
-    ContactLaw.LANKARANI_NIKRAVESH,
-    ContactLaw.HUNT_CROSSLEY,
-    ContactLaw.FLORES,
-    ContactLaw.GONTHIER,
-    ContactLaw.HU_GUO,
-    ContactLaw.IMPACT,
-)
-"""The laws the compiled contact knows (``kLawNames`` of contact_laws.c, codes 0..6 in
-`ContactLaw` order); a port of a law adds it here. Any other law is refused before anything
-is compiled (`require_compiled_law`)."""
+COMPILED_LAWS: tuple[ContactLaw, ...] = tuple(ContactLaw)
+"""The laws the compiled contact knows (``kLawNames`` of contact_laws.c, codes in `ContactLaw`
+order): all of them, the point laws and the cylindrical ones. A law added to `ContactLaw` before
+its port is refused before anything is compiled (`require_compiled_law`)."""
 
 _DISSIPATIVE = (
     ContactLaw.LANKARANI_NIKRAVESH,
@@ -167,6 +160,7 @@ def add_journal_bearing(
     min_approach_speed: float = laws.MIN_APPROACH_SPEED,
     lubrication: Lubrication | None = None,
     bearing_length: float | None = None,
+    cylinder: CylinderLaw | None = None,
 ) -> None:
     """Add one journal–bearing contact (plugin instance + its sensor, both named ``name``).
 
@@ -197,6 +191,9 @@ def add_journal_bearing(
         lubrication: the joint's oil film (`clearance.lubrication.Lubrication`), or None for a
             dry joint; its force (`clearance.contact_calibration.film`) adds to the law's.
         bearing_length: L [m] > 0, the film's length (required with ``lubrication``).
+        cylinder: a cylindrical law's constants (`cylindrical_laws.cylinder_law`), required for
+            the laws of `clearance.model.CYLINDRICAL_LAWS` (their ``stiffness`` and ``exponent``
+            are then the constants' own), None for the point laws.
 
     Raises:
         ValueError: naming the joint, the attribute, its value and what was expected, for a
@@ -242,6 +239,27 @@ def add_journal_bearing(
     }
     config["v1"] = _number(j, "v1", v1, f"> v0 = {config['v0']} [m/s]", lambda v: v > config["v0"])
 
+    if law in CYLINDRICAL_LAWS:
+        if not isinstance(cylinder, CylinderLaw) or cylinder.law is not law:
+            raise ValueError(
+                f"journal-bearing contact '{j}': law {law.name} needs its constants "
+                f"(cylindrical_laws.cylinder_law of the joint; got {cylinder!r})"
+            )
+        config["stiffness"] = cylinder.stiffness if cylinder.stiffness > 0 else 1.0  # unused by the logarithmic
+        config["exponent"] = cylinder.exponent if cylinder.exponent > 0 else 1.5
+        config["clearance"] = cylinder.clearance
+        config["max_penetration"] = cylinder.max_penetration if math.isfinite(cylinder.max_penetration) else "inf"
+        if cylinder.logarithmic:
+            config["compliance"] = cylinder.compliance
+            config["reference_force"] = cylinder.reference_force
+            config["offset"] = cylinder.offset
+        if restitution is None:
+            raise ValueError(f"journal-bearing contact '{j}': law {law.name} needs restitution")
+        config["restitution"] = _number(j, "restitution", restitution, "in [0, 1]", lambda v: 0 <= v <= 1)
+    elif cylinder is not None:
+        raise ValueError(
+            f"journal-bearing contact '{j}': cylinder constants are for the cylindrical laws, not {law.name}"
+        )
     if law in _DISSIPATIVE:
         if restitution is None:
             raise ValueError(f"journal-bearing contact '{j}': law {law.name} needs restitution")
@@ -340,6 +358,7 @@ def add_for_clearance(
         min_approach_speed=min_approach_speed,
         lubrication=clearance.lubrication,
         bearing_length=clearance.bearing_length,
+        cylinder=cylinder_law(clearance) if law in CYLINDRICAL_LAWS else None,
     )
 
 

@@ -193,7 +193,8 @@ enum {
 static const char* const kAttributes[] = {
   "journal_site", "bearing_site", "clearance", "journal_radius", "law", "stiffness",
   "exponent", "restitution", "c_max", "d_max", "friction", "v0", "v1", "min_approach_speed",
-  "film", "viscosity", "bearing_length", "transition_thickness"
+  "film", "viscosity", "bearing_length", "transition_thickness", "compliance", "reference_force",
+  "offset", "max_penetration"
 };
 
 // one force evaluation
@@ -591,7 +592,7 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
   // the normal and the film's tangential rate together (the 2x2 form of "Oil film")
   mjtNum rate = rate_geo, rate_f = vtf_geo, fel = 0;
   if (delta > 0) {
-    fel = c->lw.stiffness * pow(delta, c->lw.exponent);
+    fel = cl_elastic_force(&c->lw, delta);
   }
   if (instep) {
     mjtNum ft_last = last ? s[B_FT] : 0.0;
@@ -623,7 +624,7 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
       rate_f = Phi[2] * r0 + Phi[3] * f0 + Psi[2] * an + Psi[3] * af;
     }
   }
-  mjtNum fn = cl_normal_force(&c->lw, delta, rate, vin, &fel);
+  mjtNum fn = cl_normal_force(&c->lw, delta, fel, rate, vin);
 
   // the film's force at the rates (F_0 - D rate) and its shear torques
   mjtNum ffn = 0, fft = 0, tj = 0, tb = 0, film_power = 0;
@@ -882,7 +883,7 @@ static void jb_compute(const mjModel* m, mjData* d, int instance, int capability
   if (capability_bit & mjPLUGIN_SENSOR) {
     mjtNum out[JB_NSENSOR] = {
       ev.fn, ev.ft, ev.delta, ev.rate, ev.vin,
-      ev.delta > 0 ? ev.fel * ev.delta / (c->lw.exponent + 1) : 0.0,
+      cl_elastic_energy(&c->lw, ev.delta, ev.fel),
       s[B_WORK], ev.ecc, ev.film_n, ev.film_t
     };
     for (int i = 0; i < c->nsensor; i++) {

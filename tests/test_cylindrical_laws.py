@@ -28,7 +28,6 @@ from clearance.contact_calibration.cylindrical_laws import (
 )
 from clearance.contact_calibration.impact import clearance_impact, cylinder_impact
 from clearance.contact_calibration.laws import UnverifiedLawWarning
-from clearance.contact_plugin import attributes
 from clearance.model import CYLINDRICAL_LAWS, Clearance, ContactLaw
 from clearance.reference import simulate_system
 from clearance.reference.contact import evaluate_contact
@@ -234,24 +233,6 @@ def test_impacts_that_would_pass_the_deepest_penetration_are_refused() -> None:
 def test_point_law_entry_refuses_a_cylindrical_law() -> None:
     with pytest.raises(ValueError, match="cylindrical law: its force needs the joint's radii"):
         laws.normal_force(ContactLaw.JOHNSON, 1e-6, 0.0, 1.0, stiffness=1e10, restitution=0.9)
-
-
-@pytest.mark.parametrize("law", sorted(CYLINDRICAL_LAWS, key=list(ContactLaw).index))
-def test_exact_contact_refuses_a_law_the_compiled_library_does_not_know(law: ContactLaw) -> None:
-    assert law not in attributes.COMPILED_LAWS  # until the compiled port adds it
-    with pytest.raises(ValueError, match=rf"joint 'pin': law '{law.value}' is not in the compiled exact contact yet"):
-        attributes.require_compiled_law(law, "pin")
-
-
-def test_a_run_in_exact_mode_refuses_the_law_before_any_work() -> None:
-    from clearance import ModelOptions, simulate
-    from clearance.builders import slider_crank
-
-    mech = slider_crank(law=ContactLaw.JOHNSON, bearing_length=0.02)
-    with pytest.raises(
-        ValueError, match=r"^joint 'rod_slider': law 'johnson' is not in the compiled exact contact yet"
-    ):
-        simulate(mech, duration=1e-4, options=ModelOptions(contact_mode="exact"))
 
 
 def test_retrofit_play_takes_the_bearing_length() -> None:

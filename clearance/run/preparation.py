@@ -19,6 +19,7 @@ from typing import TYPE_CHECKING, Any
 import mujoco
 import numpy as np
 
+from clearance.checks import of_type
 from clearance.contact_calibration.effective_mass import cycle_effective_mass
 from clearance.contact_calibration.laws import bearing_stiffness, contact_omega
 from clearance.contact_plugin import PLUGIN_NAME, is_available
@@ -34,7 +35,7 @@ from clearance.mjcf import (
     choose_segments,
     refuse_translational_clearance,
 )
-from clearance.model import DriveKind, Joint, Mechanism
+from clearance.model import CYLINDRICAL_LAWS, DriveKind, Joint, Mechanism
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
 
 if TYPE_CHECKING:
@@ -123,6 +124,17 @@ def _refuse_lubricated(mechanism: Mechanism, mode: ContactMode) -> None:
     )
 
 
+def check_run_arguments(mechanism: object, options: object) -> None:
+    """Refuse a mechanism or options of the wrong type, naming the argument (before any work).
+
+    Raises:
+        clearance.checks.WrongTypeError: ``mechanism`` is not a `Mechanism`, or ``options`` is
+            neither a `ModelOptions` nor None (a `TypeError` and a `ValueError`).
+    """
+    of_type("mechanism", mechanism, Mechanism, "a Mechanism (from a builder, e.g. clearance.builders.slider_crank())")
+    of_type("options", options, (ModelOptions, type(None)), "a ModelOptions (e.g. ModelOptions(timestep=1e-6)) or None")
+
+
 def prepare(
     mechanism: Mechanism,
     options: ModelOptions | None = None,
@@ -146,6 +158,7 @@ def prepare(
         ValueError: bad options; a slider with play (translational clearance runs in the
             reference solver only so far).
     """
+    check_run_arguments(mechanism, options)
     refuse_translational_clearance(mechanism)  # before any work: MuJoCo has no slider with play yet
     options = options or ModelOptions()
     cjoints = mechanism.clearance_joints
@@ -254,10 +267,17 @@ def _add_exact_contact(built: BuiltModel, joint: Joint) -> dict[str, Any]:
         journal_site=f"{joint.name}__journal",
         bearing_site=f"{joint.name}__bearing",
     )
+    if c.law in CYLINDRICAL_LAWS:  # the law's own constants, not the point laws' Hertz K
+        from dataclasses import asdict
+
+        from clearance.contact_calibration.cylindrical_laws import cylinder_law
+
+        law_meta: dict[str, Any] = {k: v for k, v in asdict(cylinder_law(c)).items() if k != "law"}
+    else:
+        law_meta = {"stiffness": bearing_stiffness(c), "exponent": 1.5}
     return {
         "law": c.law.value,
-        "stiffness": bearing_stiffness(c),
-        "exponent": 1.5,
+        **law_meta,
         "restitution": c.restitution,
         "friction": c.friction,
         "source": f"exact: compiled plugin {PLUGIN_NAME}",
