@@ -91,6 +91,7 @@ setup(
                 "contact_plugin/work_meter.c",
                 "contact_plugin/backlash_stop.c",
                 "contact_plugin/film.c",
+                "contact_plugin/instep.c",
             ],
             extra_compile_args=["-O2", "-std=c99"],
             optional=True,

@@ -178,6 +178,7 @@
 
 #include "contact_laws.h"
 #include "film.h"
+#include "instep.h"
 #include "plugin_util.h"
 
 #define JB_NAME "clearance.journal_bearing"
@@ -230,7 +231,7 @@ typedef struct {
   mjtNum clearance, journal_radius;
   clLaw lw;                  // the normal law
   clFilm film;               // the oil film (film.model FILM_NONE: a dry joint)
-  mjtNum friction, v0, v1;
+  clFriction fr;             // Ambrosio's friction
   mjtNum min_speed;
   int nsensor;
   int* sensor_adr;           // sensordata addresses of this instance's sensors
@@ -250,12 +251,7 @@ typedef struct {
   mjtNum* vec_rb;            // film: row of the bearing's angular velocity about z (nv)
   mjtNum* own_film;          // film: its generalized force, then h M^-1 of it (nv)
   mjtNum* slot_vec;          // per cache slot: qvel, own and vec_n at the evaluation (3 nv each)
-  // the equality constraints' rows, at most eq_max of them (allocated in init)
-  int eq_max;
-  mjtNum* eq_rows;           // their Jacobian rows (eq_max nv)
-  mjtNum* eq_y;              // M^-1 of each row (eq_max nv)
-  mjtNum* eq_a;              // J_c M^-1 J_c' + R, then its Cholesky factor (eq_max^2)
-  mjtNum* eq_z;              // solves (2 eq_max)
+  clEquality eq;             // the equality constraints' response (instep.h)
 } jbData;
 
 
@@ -264,7 +260,7 @@ typedef struct {
 
 // parse and validate every attribute into c; 0 on failure (a warning says why)
 static int configure(const mjModel* m, int instance, jbData* c) {
-  static const mjtNum kZero = 0.0, kV0 = 1e-4, kV1 = 1e-3, kMinSpeed = 1e-3;
+  static const mjtNum kMinSpeed = 1e-3;
   if (!cl_read_site(m, instance, "journal_site", &c->journal_site) ||
       !cl_read_site(m, instance, "bearing_site", &c->bearing_site)) {
     return 0;
@@ -285,12 +281,7 @@ static int configure(const mjModel* m, int instance, jbData* c) {
     return 0;
   }
 
-  if (!cl_read_number(m, instance, "friction", &kZero, &c->friction) ||
-      !cl_check(m, c->friction >= 0, instance, "friction", c->friction, ">= 0") ||
-      !cl_read_number(m, instance, "v0", &kV0, &c->v0) ||
-      !cl_read_number(m, instance, "v1", &kV1, &c->v1) ||
-      !cl_check(m, c->v0 >= 0, instance, "v0", c->v0, ">= 0 [m/s]") ||
-      !cl_check(m, c->v1 > c->v0, instance, "v1", c->v1, "> v0 [m/s]") ||
+  if (!cl_configure_friction(m, instance, &c->fr) ||
       !cl_read_number(m, instance, "min_approach_speed", &kMinSpeed, &c->min_speed) ||
       !cl_check(m, c->min_speed > 0, instance, "min_approach_speed", c->min_speed, "> 0 [m/s]")) {
     return 0;
@@ -300,38 +291,6 @@ static int configure(const mjModel* m, int instance, jbData* c) {
 
 
 //---------------------------------- contact evaluation --------------------------------------------
-
-
-// Ambrosio's coefficient c_d(v) sign(v): F_t = -mu F_n ramp(v), the operations of laws._friction
-static mjtNum friction_ramp(const jbData* c, mjtNum vt) {
-  mjtNum cd = mju_clip((mju_abs(vt) - c->v0) / (c->v1 - c->v0), 0.0, 1.0);
-  mjtNum sign = vt > 0 ? 1.0 : (vt < 0 ? -1.0 : 0.0);
-  return cd * sign;
-}
-
-// Ambrosio friction at v_t, the operations of laws._friction
-static mjtNum friction_force(const jbData* c, mjtNum fn, mjtNum vt) {
-  if (c->friction == 0) {
-    return 0.0;
-  }
-  return -c->friction * friction_ramp(c, vt) * fn + 0.0;
-}
-
-// the tangential velocity v at the step's end that friction evaluated there gives:
-// v = v_free + k ramp(v)... with k = -h w_tt mu F_n <= 0, i.e. v + kk ramp(v) = v_free with
-// kk = h w_tt mu F_n >= 0; v + kk ramp(v) increases with v, so the root is unique and each
-// piece of the ramp is linear (see "Friction near rest")
-static mjtNum implicit_sliding_velocity(const jbData* c, mjtNum v_free, mjtNum kk) {
-  mjtNum a = mju_abs(v_free), sign = v_free >= 0 ? 1.0 : -1.0;
-  if (a <= c->v0 || kk <= 0) {
-    return v_free;
-  }
-  if (a - kk >= c->v1) {
-    return sign * (a - kk);  // gross sliding through the step
-  }
-  mjtNum slope = kk / (c->v1 - c->v0);
-  return sign * (a + slope * c->v0) / (1.0 + slope);  // inside the ramp
-}
 
 
 // the rows of the normal rate and of the tangential velocity over the dofs: with the
@@ -362,75 +321,6 @@ static void contact_rows(const mjModel* m, const mjData* d, jbData* c, const mjt
       c->vec_rb[i] = z[0] * rb[i] + z[1] * rb[nv + i] + z[2] * rb[2 * nv + i];
       c->vec_tf[i] = t[0] * dx + t[1] * dy + t[2] * dzz - ecc * c->vec_rb[i];
     }
-  }
-}
-
-// the equality constraints' rows at most: connect 3, weld 6, joint and tendon couplings 1 (a
-// model with other equality kinds, or more rows at run time, keeps the free response)
-static int equality_rows_max(const mjModel* m) {
-  int n = 0;
-  for (int i = 0; i < m->neq; i++) {
-    int type = m->eq_type[i];
-    if (type == mjEQ_CONNECT) n += 3;
-    else if (type == mjEQ_WELD) n += 6;
-    else if (type == mjEQ_JOINT || type == mjEQ_TENDON) n += 1;
-    else return -1;
-  }
-  return n;
-}
-
-// The equality constraints' rows at this state and the Cholesky factor of J_c M^-1 J_c' + R
-// (kept in c); returns their count k, or 0 (none, more than the model declares, or singular:
-// the responses stay free). See `constrain`.
-static int equality_factor(const mjModel* m, mjData* d, jbData* c) {
-  int nv = m->nv, k = 0;
-  if (c->eq_max <= 0) {
-    return 0;
-  }
-  for (int r = 0; r < d->nefc; r++) {
-    if (d->efc_type[r] != mjCNSTR_EQUALITY) continue;
-    if (k == c->eq_max) return 0;  // more rows than the model declares: keep the free response
-    mjtNum* row = c->eq_rows + k * nv;
-    if (mj_isSparse(m)) {
-      mju_zero(row, nv);
-      int adr = d->efc_J_rowadr[r];
-      for (int j = 0; j < d->efc_J_rownnz[r]; j++) {
-        row[d->efc_J_colind[adr + j]] = d->efc_J[adr + j];
-      }
-    } else {
-      mju_copy(row, d->efc_J + r * nv, nv);
-    }
-    c->eq_z[k] = d->efc_R[r];  // R, held here until the factor is built
-    k++;
-  }
-  if (k == 0) {
-    return 0;
-  }
-  mj_solveM(m, d, c->eq_y, c->eq_rows, k);
-  for (int i = 0; i < k; i++) {
-    for (int j = 0; j <= i; j++) {
-      mjtNum a = mju_dot(c->eq_rows + i * nv, c->eq_y + j * nv, nv);
-      c->eq_a[i * k + j] = a;
-      c->eq_a[j * k + i] = a;
-    }
-    c->eq_a[i * k + i] += c->eq_z[i];
-  }
-  return mju_cholFactor(c->eq_a, k, mjMINVAL) < k ? 0 : k;  // singular: keep the free response
-}
-
-// Turn a free response u = M^-1 f (f a row or a generalized force) into the response with the
-// equality constraints' rows acting as the constraint solver solves them alone (their soft
-// dynamics at this state): u -= Y (J_c M^-1 J_c' + R)^-1 J_c u, Y = M^-1 J_c'. A loop closure
-// or a pin held by a connect then moves as the loop lets it, not as the free tree would.
-static void constrain(const jbData* c, int k, int nv, mjtNum* u) {
-  mjtNum* b = c->eq_z;
-  mjtNum* z = c->eq_z + c->eq_max;
-  for (int i = 0; i < k; i++) {
-    b[i] = mju_dot(c->eq_rows + i * nv, u, nv);
-  }
-  mju_cholSolve(z, c->eq_a, b, k);
-  for (int i = 0; i < k; i++) {
-    mju_addToScl(u, c->eq_y + i * nv, -z[i], nv);
   }
 }
 
@@ -504,17 +394,17 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
   if (instep) {
     contact_rows(m, d, c, n, ev->tangent, z, ecc, jn, jt, c->scratch);
     mj_solveM(m, d, c->un, jn, 2);  // un, ut: the two rows stored one after the other
-    neq = equality_factor(m, d, c);
+    neq = cl_equality_factor(m, d, &c->eq);
     if (neq) {
-      constrain(c, neq, nv, c->un);
-      constrain(c, neq, nv, c->ut);
+      cl_constrain(&c->eq, neq, nv, c->un);
+      cl_constrain(&c->eq, neq, nv, c->ut);
     }
     w_nn = mju_dot(jn, c->un, nv);
     w_nt = mju_dot(jn, c->ut, nv);
     w_tt = mju_dot(jt, c->ut, nv);
     if (film) {
       mj_solveM(m, d, c->u_tf, c->vec_tf, 1);
-      if (neq) constrain(c, neq, nv, c->u_tf);
+      if (neq) cl_constrain(&c->eq, neq, nv, c->u_tf);
       w_nf = mju_dot(jn, c->u_tf, nv);
       w_ff = mju_dot(c->vec_tf, c->u_tf, nv);
       w_tf = mju_dot(jt, c->u_tf, nv);
@@ -613,7 +503,7 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
         torque[i] = couette * (c->vec_rb[i] - c->vec_rj[i]);
       }
       mj_solveM(m, d, c->own_film, torque, 1);
-      if (neq) constrain(c, neq, nv, c->own_film);
+      if (neq) cl_constrain(&c->eq, neq, nv, c->own_film);
       mjtNum an = other_n + kin_n + h * (w_nn * hn + w_nf * ht + w_nt * ft_last + mju_dot(jn, c->own_film, nv));
       mjtNum af = other_f + kin_f +
                   h * (w_nf * hn + w_ff * ht + w_tf * ft_last + mju_dot(c->vec_tf, c->own_film, nv));
@@ -645,7 +535,7 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
                    tj * c->vec_rj[i] + tb * c->vec_rb[i];
       }
       mj_solveM(m, d, c->own_film, force, 1);
-      if (neq) constrain(c, neq, nv, c->own_film);
+      if (neq) cl_constrain(&c->eq, neq, nv, c->own_film);
       mju_scl(c->own_film, c->own_film, h, nv);
     }
   }
@@ -653,14 +543,14 @@ static void evaluate(const mjModel* m, mjData* d, jbData* c, const mjtNum* s, jb
   // friction at the tangential velocity it leaves at the step's end (semi-implicit), or at
   // the sampled one (RK4)
   mjtNum vt = vt_geo, ft = 0;
-  if (c->friction != 0 && fn > 0) {
+  if (c->fr.mu != 0 && fn > 0) {
     if (instep) {
       mjtNum v_free = vt_geo + other_t - h * w_nt * fn + (film ? mju_dot(jt, c->own_film, nv) : 0.0);
-      mjtNum v_end = implicit_sliding_velocity(c, v_free, h * w_tt * c->friction * fn);
-      ft = friction_force(c, fn, v_end);
+      mjtNum v_end = cl_implicit_sliding_velocity(&c->fr, v_free, h * w_tt * c->fr.mu * fn);
+      ft = cl_friction_force(&c->fr, fn, v_end);
       vt = 0.5 * (vt_geo + v_end);
     } else {
-      ft = friction_force(c, fn, vt_geo);
+      ft = cl_friction_force(&c->fr, fn, vt_geo);
     }
   }
 
@@ -789,7 +679,7 @@ static int jb_nsensordata(const mjModel* m, int instance, int sensor_id) {
 static void jb_free(jbData* c) {
   free(c->sensor_adr);
   free(c->vec_n);
-  free(c->eq_rows);
+  cl_equality_free(&c->eq);
   free(c);
 }
 
@@ -822,18 +712,10 @@ static int jb_init(const mjModel* m, mjData* d, int instance) {
   c->vec_rb = c->vec_n + 20 * nv;
   c->own_film = c->vec_n + 21 * nv;
   c->slot_vec = c->vec_n + 22 * nv;
-  c->eq_max = equality_rows_max(m);
-  if (c->eq_max > 0) {
-    int k = c->eq_max;
-    c->eq_rows = (mjtNum*)calloc((size_t)(2 * k * nv + k * k + 2 * k), sizeof(mjtNum));
-    if (!c->eq_rows) {
-      jb_free(c);
-      mju_warning(JB_NAME " instance %d: out of memory", instance);
-      return -1;
-    }
-    c->eq_y = c->eq_rows + k * nv;
-    c->eq_a = c->eq_y + k * nv;
-    c->eq_z = c->eq_a + k * k;
+  if (!cl_equality_init(m, &c->eq)) {
+    jb_free(c);
+    mju_warning(JB_NAME " instance %d: out of memory", instance);
+    return -1;
   }
   d->plugin_data[instance] = (uintptr_t)c;
   return 0;
