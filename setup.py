@@ -92,6 +92,7 @@ setup(
                 "contact_plugin/backlash_stop.c",
                 "contact_plugin/film.c",
                 "contact_plugin/instep.c",
+                "contact_plugin/slider_guide.c",
             ],
             extra_compile_args=["-O2", "-std=c99"],
             optional=True,

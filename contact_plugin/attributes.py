@@ -54,6 +54,8 @@ __all__ = [
     "sensor_offsets",
     "state_address",
     "state_size",
+    "number_attribute",
+    "site_of",
 ]
 
 SENSOR_FIELDS: tuple[str, ...] = (
@@ -119,24 +121,50 @@ def require_compiled_law(law: ContactLaw, joint: str) -> None:
         )
 
 
-def _number(joint: str, attribute: str, value: Any, expected: str, ok: Any) -> float:
-    """``value`` as a float if finite and ``ok(value)``, else a ValueError saying what was expected."""
+def number_attribute(
+    contact: str, attribute: str, value: Any, expected: str, ok: Any, what: str = "journal-bearing contact"
+) -> float:
+    """``value`` as a float if finite and ``ok(value)``, else a ValueError saying what was expected.
+
+    Args:
+        contact: the contact's name, for the message.
+        attribute: the attribute's name.
+        value: the value given.
+        expected: what was expected, in words (with the unit).
+        ok: a predicate on the float.
+        what: the kind of contact, for the message.
+
+    Raises:
+        ValueError: ``value`` not a finite number or ``ok`` false.
+    """
     if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"journal-bearing contact '{joint}': {attribute} must be a number {expected} (got {value!r})")
+        raise ValueError(f"{what} '{contact}': {attribute} must be a number {expected} (got {value!r})")
     v = float(value)
     if not (math.isfinite(v) and ok(v)):
-        raise ValueError(
-            f"journal-bearing contact '{joint}': {attribute} must be finite and {expected} (got {value!r})"
-        )
+        raise ValueError(f"{what} '{contact}': {attribute} must be finite and {expected} (got {value!r})")
     return v
 
 
-def _site(spec: mujoco.MjSpec, joint: str, attribute: str, name: Any) -> mujoco.MjsSite:
+def site_of(
+    spec: mujoco.MjSpec, contact: str, attribute: str, name: Any, what: str = "journal-bearing contact"
+) -> mujoco.MjsSite:
+    """The spec's site named ``name``, else a ValueError naming the contact and the attribute.
+
+    Args:
+        spec: the model under construction.
+        contact: the contact's name, for the message.
+        attribute: the attribute that names the site.
+        name: the site's name.
+        what: the kind of contact, for the message.
+
+    Raises:
+        ValueError: ``name`` not a non-empty string or no such site.
+    """
     if not isinstance(name, str) or not name:
-        raise ValueError(f"journal-bearing contact '{joint}': {attribute} must be a site name (got {name!r})")
+        raise ValueError(f"{what} '{contact}': {attribute} must be a site name (got {name!r})")
     site = spec.site(name)
     if site is None:
-        raise ValueError(f"journal-bearing contact '{joint}': {attribute} = {name!r} is not a site of the spec")
+        raise ValueError(f"{what} '{contact}': {attribute} = {name!r} is not a site of the spec")
     return site
 
 
@@ -211,8 +239,8 @@ def add_journal_bearing(
         raise ValueError(
             f"journal-bearing contact '{j}': name {name!r} is already used by a plugin instance or a sensor of the spec"
         )
-    journal = _site(spec, j, "journal_site", journal_site)
-    bearing = _site(spec, j, "bearing_site", bearing_site)
+    journal = site_of(spec, j, "journal_site", journal_site)
+    bearing = site_of(spec, j, "bearing_site", bearing_site)
     if journal.parent.name == bearing.parent.name:
         raise ValueError(
             f"journal-bearing contact '{j}': journal_site {journal_site!r} and bearing_site "
@@ -228,16 +256,18 @@ def add_journal_bearing(
     config = {
         "journal_site": journal_site,
         "bearing_site": bearing_site,
-        "clearance": _number(j, "clearance", clearance, "> 0 [m]", lambda v: v > 0),
-        "journal_radius": _number(j, "journal_radius", journal_radius, "> 0 [m]", lambda v: v > 0),
+        "clearance": number_attribute(j, "clearance", clearance, "> 0 [m]", lambda v: v > 0),
+        "journal_radius": number_attribute(j, "journal_radius", journal_radius, "> 0 [m]", lambda v: v > 0),
         "law": law.value,
-        "stiffness": _number(j, "stiffness", stiffness, "> 0 [N/m^n]", lambda v: v > 0),
-        "exponent": _number(j, "exponent", exponent, "> 0", lambda v: v > 0),
-        "friction": _number(j, "friction", friction, ">= 0", lambda v: v >= 0),
-        "v0": _number(j, "v0", v0, ">= 0 [m/s]", lambda v: v >= 0),
-        "min_approach_speed": _number(j, "min_approach_speed", min_approach_speed, "> 0 [m/s]", lambda v: v > 0),
+        "stiffness": number_attribute(j, "stiffness", stiffness, "> 0 [N/m^n]", lambda v: v > 0),
+        "exponent": number_attribute(j, "exponent", exponent, "> 0", lambda v: v > 0),
+        "friction": number_attribute(j, "friction", friction, ">= 0", lambda v: v >= 0),
+        "v0": number_attribute(j, "v0", v0, ">= 0 [m/s]", lambda v: v >= 0),
+        "min_approach_speed": number_attribute(
+            j, "min_approach_speed", min_approach_speed, "> 0 [m/s]", lambda v: v > 0
+        ),
     }
-    config["v1"] = _number(j, "v1", v1, f"> v0 = {config['v0']} [m/s]", lambda v: v > config["v0"])
+    config["v1"] = number_attribute(j, "v1", v1, f"> v0 = {config['v0']} [m/s]", lambda v: v > config["v0"])
 
     if law in CYLINDRICAL_LAWS:
         if not isinstance(cylinder, CylinderLaw) or cylinder.law is not law:
@@ -255,7 +285,7 @@ def add_journal_bearing(
             config["offset"] = cylinder.offset
         if restitution is None:
             raise ValueError(f"journal-bearing contact '{j}': law {law.name} needs restitution")
-        config["restitution"] = _number(j, "restitution", restitution, "in [0, 1]", lambda v: 0 <= v <= 1)
+        config["restitution"] = number_attribute(j, "restitution", restitution, "in [0, 1]", lambda v: 0 <= v <= 1)
     elif cylinder is not None:
         raise ValueError(
             f"journal-bearing contact '{j}': cylinder constants are for the cylindrical laws, not {law.name}"
@@ -263,7 +293,7 @@ def add_journal_bearing(
     if law in _DISSIPATIVE:
         if restitution is None:
             raise ValueError(f"journal-bearing contact '{j}': law {law.name} needs restitution")
-        e = _number(j, "restitution", restitution, "in [0, 1]", lambda v: 0 <= v <= 1)
+        e = number_attribute(j, "restitution", restitution, "in [0, 1]", lambda v: 0 <= v <= 1)
         try:
             laws.hysteresis_factor(law, e)  # the per-law range; warns once for HU_GUO
         except ValueError as err:
@@ -275,8 +305,8 @@ def add_journal_bearing(
                 f"journal-bearing contact '{j}': law IMPACT needs c_max [N s/m] and d_max [m] "
                 f"(got c_max={c_max!r}, d_max={d_max!r})"
             )
-        config["c_max"] = _number(j, "c_max", c_max, ">= 0 [N s/m]", lambda v: v >= 0)
-        config["d_max"] = _number(j, "d_max", d_max, "> 0 [m]", lambda v: v > 0)
+        config["c_max"] = number_attribute(j, "c_max", c_max, ">= 0 [N s/m]", lambda v: v >= 0)
+        config["d_max"] = number_attribute(j, "d_max", d_max, "> 0 [m]", lambda v: v > 0)
     elif c_max is not None or d_max is not None:
         raise ValueError(
             f"journal-bearing contact '{j}': c_max/d_max (got {c_max!r}, {d_max!r}) are used by "
@@ -290,8 +320,8 @@ def add_journal_bearing(
             raise ValueError(f"journal-bearing contact '{j}': a lubricated joint needs bearing_length [m]")
         config["film"] = lubrication.film.value
         config["viscosity"] = lubrication.viscosity
-        config["bearing_length"] = _number(j, "bearing_length", bearing_length, "> 0 [m]", lambda v: v > 0)
-        config["transition_thickness"] = _number(
+        config["bearing_length"] = number_attribute(j, "bearing_length", bearing_length, "> 0 [m]", lambda v: v > 0)
+        config["transition_thickness"] = number_attribute(
             j,
             "transition_thickness",
             lubrication.transition_thickness,

@@ -2,6 +2,7 @@
 
 #include "instep.h"
 
+#include <math.h>
 #include <stdlib.h>
 
 #include "plugin_util.h"
@@ -122,5 +123,66 @@ void cl_constrain(const clEquality* eq, int k, int nv, mjtNum* u) {
   mju_cholSolve(z, eq->a, b, k);
   for (int i = 0; i < k; i++) {
     mju_addToScl(u, eq->y + i * nv, -z[i], nv);
+  }
+}
+
+void cl_exponential_means_diag(int k, mjtNum h, const mjtNum* W, const mjtNum* damping,
+                               mjtNum* Phi, mjtNum* Psi) {
+  mjtNum a[16], v[16], sq[4];
+  for (int i = 0; i < k; i++) {
+    sq[i] = sqrt(damping[i]);
+  }
+  for (int i = 0; i < k; i++) {
+    for (int j = 0; j < k; j++) {
+      a[i * k + j] = h * sq[i] * 0.5 * (W[i * k + j] + W[j * k + i]) * sq[j];
+      v[i * k + j] = i == j ? 1.0 : 0.0;
+    }
+  }
+  // cyclic Jacobi: a -> diag, v the eigenvectors (columns)
+  for (int sweep = 0; sweep < 50; sweep++) {
+    mjtNum off = 0, diag = 0;
+    for (int i = 0; i < k; i++) {
+      diag += a[i * k + i] * a[i * k + i];
+      for (int j = i + 1; j < k; j++) off += a[i * k + j] * a[i * k + j];
+    }
+    if (off <= 1e-30 * diag || off == 0) break;
+    for (int p = 0; p < k; p++) {
+      for (int q = p + 1; q < k; q++) {
+        mjtNum apq = a[p * k + q];
+        if (apq == 0) continue;
+        mjtNum theta = 0.5 * atan2(2.0 * apq, a[q * k + q] - a[p * k + p]);
+        mjtNum cs = cos(theta), sn = sin(theta);
+        for (int r = 0; r < k; r++) {  // a = J' a J, J the rotation in (p, q)
+          mjtNum arp = a[r * k + p], arq = a[r * k + q];
+          a[r * k + p] = cs * arp - sn * arq;
+          a[r * k + q] = sn * arp + cs * arq;
+        }
+        for (int r = 0; r < k; r++) {
+          mjtNum apr = a[p * k + r], aqr = a[q * k + r];
+          a[p * k + r] = cs * apr - sn * aqr;
+          a[q * k + r] = sn * apr + cs * aqr;
+        }
+        for (int r = 0; r < k; r++) {
+          mjtNum vrp = v[r * k + p], vrq = v[r * k + q];
+          v[r * k + p] = cs * vrp - sn * vrq;
+          v[r * k + q] = sn * vrp + cs * vrq;
+        }
+      }
+    }
+  }
+  mjtNum fphi[4], fpsi[4];
+  for (int i = 0; i < k; i++) {
+    cl_exponential_means(mju_max(a[i * k + i], 0.0), fphi + i, fpsi + i);
+  }
+  for (int i = 0; i < k; i++) {
+    for (int j = 0; j < k; j++) {
+      mjtNum p = 0, q = 0;
+      for (int e = 0; e < k; e++) {
+        p += v[i * k + e] * fphi[e] * v[j * k + e];
+        q += v[i * k + e] * fpsi[e] * v[j * k + e];
+      }
+      Phi[i * k + j] = p / sq[i] * sq[j];
+      Psi[i * k + j] = q / sq[i] * sq[j];
+    }
   }
 }

@@ -47,4 +47,12 @@ int cl_equality_factor(const mjModel* m, mjData* d, clEquality* eq);
 // then moves as the loop lets it, not as the free tree would.
 void cl_constrain(const clEquality* eq, int k, int nv, mjtNum* u);
 
+// For k coupled rates r' = A - (1/h) G r over a step h with G = h W D (W symmetric positive
+// semi-definite k x k, row-major; D = diag(damping), every damping > 0; k <= 4), the matrices
+// Phi = phi1(-G) and Psi = psi(G) (cl_exponential_means on G), so that the mean of r over the
+// step is Phi r0 + h Psi A: through the symmetric Gs = h D^1/2 W D^1/2 (Jacobi's eigenvalue
+// method), f(G) = D^-1/2 f(Gs) D^1/2.
+void cl_exponential_means_diag(int k, mjtNum h, const mjtNum* W, const mjtNum* damping,
+                               mjtNum* Phi, mjtNum* Psi);
+
 #endif  // CLEARANCE_INSTEP_H_

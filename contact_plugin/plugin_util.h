@@ -72,5 +72,6 @@ void cl_exponential_means(mjtNum g, mjtNum* phi1, mjtNum* psi);
 void cl_register_journal_bearing(void);
 void cl_register_work_meter(void);
 void cl_register_backlash_stop(void);
+void cl_register_slider_guide(void);
 
 #endif  // CLEARANCE_PLUGIN_UTIL_H_
