@@ -10,7 +10,16 @@ from __future__ import annotations
 import math
 import numbers
 
-__all__ = ["MAX_DRIVE_RPM", "MAX_DRIVE_SPEED", "NotANumberError", "finite", "in_range", "positive"]
+__all__ = [
+    "MAX_DRIVE_RPM",
+    "MAX_DRIVE_SPEED",
+    "NotANumberError",
+    "WrongTypeError",
+    "finite",
+    "in_range",
+    "of_type",
+    "positive",
+]
 
 MAX_DRIVE_RPM = 60_000.0
 """Fastest drive speed accepted from a user [rpm] (1000 revolutions per second).
@@ -27,7 +36,33 @@ MAX_DRIVE_SPEED = MAX_DRIVE_RPM * 2.0 * math.pi / 60.0
 """`MAX_DRIVE_RPM` in rad/s."""
 
 
-class NotANumberError(TypeError, ValueError):
+class WrongTypeError(TypeError, ValueError):
+    """An argument of the wrong type (a file name where a model is wanted, a dict for an options record).
+
+    Both a `TypeError` and a `ValueError`, so callers catching either see it.
+    """
+
+
+def of_type(name: str, value: object, expected: type | tuple[type, ...], what: str) -> None:
+    """Refuse ``value`` unless it is an instance of ``expected``, naming the argument.
+
+    Args:
+        name: the argument, for the message.
+        value: what was given.
+        expected: the type(s) accepted.
+        what: the expected type for people, with how to get one (``a Mechanism (from a builder,
+            e.g. clearance.builders.slider_crank())``).
+
+    Raises:
+        WrongTypeError: ``value`` is not an ``expected``.
+    """
+    if not isinstance(value, expected):
+        shown = repr(value)
+        shown = shown if len(shown) <= 60 else shown[:57] + "..."
+        raise WrongTypeError(f"{name} must be {what} (got {type(value).__name__} {shown})")
+
+
+class NotANumberError(WrongTypeError):
     """A number was expected and something else was given (a string, None, a bool).
 
     Both a `TypeError` and a `ValueError`, so callers catching either see it.
