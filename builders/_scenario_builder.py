@@ -152,6 +152,9 @@ def from_builder(t: Table) -> Mechanism:
         kwargs[param] = _convert(t, key, param, factor, value)
         keys[param] = key
         t.used.add(key)
+    speed = CATALOGUE[name].speed_keyword
+    if isinstance(kwargs.get(speed), float) and kwargs[speed] < 0:  # as the command line's --rpm
+        raise t.error(keys[speed], f"must be > 0: the drive's speed, as --rpm (got {t.data[keys[speed]]!r})")
     try:
         return builder(**kwargs)
     except AssemblyError as e:

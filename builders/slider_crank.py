@@ -13,7 +13,7 @@ import math
 from typing import Unpack
 
 from clearance.builders._contact import ClearanceFactory, ContactKeywords, contact_keywords
-from clearance.checks import positive
+from clearance.checks import finite, positive
 from clearance.model import (
     Drive,
     DriveKind,
@@ -36,8 +36,12 @@ _SLIDERS = ("slider_guide",)
 
 
 def rpm(value: float) -> float:
-    """Convert revolutions per minute to rad/s."""
-    return value * UNITS["angular_speed"]["rpm"]
+    """Convert revolutions per minute to rad/s.
+
+    Raises:
+        clearance.checks.NotANumberError: ``value`` is not a finite number (a `TypeError`).
+    """
+    return finite("rpm", value) * UNITS["angular_speed"]["rpm"]
 
 
 @contact_keywords(clearance_at=("rod_slider",), radial_clearance=0.5e-3)

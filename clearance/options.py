@@ -11,6 +11,8 @@ import enum
 import math
 from dataclasses import dataclass
 
+from clearance.checks import NotANumberError, finite, of_type
+
 __all__ = ["GeomType", "ContactMode", "DEFAULT_TIMESTEP", "ModelOptions", "ContactParameters"]
 
 
@@ -93,10 +95,14 @@ class ModelOptions:
 
     def __post_init__(self) -> None:
         if self.segments is not None:
-            if not isinstance(self.segments, int) or isinstance(self.segments, bool) or self.segments < 8:
+            if not isinstance(self.segments, int) or isinstance(self.segments, bool):
+                raise NotANumberError(f"segments must be an integer >= 8 (got {self.segments!r})")
+            if self.segments < 8:
                 raise ValueError(f"segments must be an integer >= 8 (got {self.segments!r})")
         for name in ("journal_geom", "segment_geom"):
             v = getattr(self, name)
+            if not isinstance(v, (GeomType, str)):
+                of_type(name, v, GeomType, f"a GeomType or one of {[g.value for g in GeomType]}")
             if not isinstance(v, GeomType):
                 try:
                     object.__setattr__(self, name, GeomType(v))
@@ -104,6 +110,13 @@ class ModelOptions:
                     raise ValueError(f"{name} must be one of {[g.value for g in GeomType]} (got {v!r})") from None
         if self.journal_geom is GeomType.BOX:
             raise ValueError("journal_geom must be sphere, capsule or cylinder (got 'box')")
+        if not isinstance(self.contact_mode, (ContactMode, str)):
+            of_type(
+                "contact_mode",
+                self.contact_mode,
+                ContactMode,
+                f"a ContactMode or one of {[c.value for c in ContactMode]}",
+            )
         if not isinstance(self.contact_mode, ContactMode):
             try:
                 object.__setattr__(self, "contact_mode", ContactMode(self.contact_mode))
@@ -111,7 +124,8 @@ class ModelOptions:
                 raise ValueError(
                     f"contact_mode must be one of {[c.value for c in ContactMode]} (got {self.contact_mode!r})"
                 ) from None
-        if isinstance(self.timestep, (int, float)) and self.timestep == 0:
+        finite("timestep", self.timestep)  # a number: a string or None is a type error, named
+        if self.timestep == 0:
             object.__setattr__(self, "timestep", DEFAULT_TIMESTEP[self.contact_mode])
         h = self.timestep
         if not isinstance(h, (int, float)) or not math.isfinite(h) or not 0 < h <= 1e-2:

@@ -309,9 +309,9 @@ def _progress(
     if progress is False:
         return _nothing, None
     if progress is True:
-        from tqdm.auto import tqdm
+        from clearance.progress import progress_bar
 
-        bar = tqdm(total=round(duration * 1e3, 9), unit="ms", desc=f"reference {name}")
+        bar = progress_bar(round(duration * 1e3, 9), unit="ms", desc=f"reference {name}")
         done = [0.0]
 
         def cb(t: float) -> None:
@@ -404,7 +404,7 @@ def _metadata(system: ReferenceSystem, traj: Trajectory, settings: dict[str, Any
         "n_steps": traj.n_steps,
         "n_restarts": traj.n_restarts,
         "n_projections": traj.n_projections,
-        "wall_time_s": traj.wall_time_s,
+        "wall_time_s": float(f"{traj.wall_time_s:.4g}"),  # 4 significant digits, as simulate's
         "package_version": __version__,
         "mujoco_version": None,
         "time_step": None,

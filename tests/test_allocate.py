@@ -89,6 +89,8 @@ def test_grid_optimum_is_the_cheapest_feasible_cell():
     got = cheapest_clearances([lambda c: float(w @ c)], [budget], cost, [1e-5] * 2, [1e-3] * 2, levels=levels)
     cells = [np.array(c) for c in itertools.product(levels, levels) if w @ np.array(c) <= budget]
     best = min(cells, key=cost)
+    # exact: both are cells of the levels, copied; the one cell on the budget, (1e-4, 1e-4), sums to
+    # 4e-4 exactly in w @ c, with or without a fused multiply-add
     assert got is not None and np.array_equal(got, best)
     eq = equal_clearance([lambda c: float(w @ c)], [budget], [1e-5] * 2, [1e-3] * 2, levels=levels)
     assert eq == 1e-4  # 4 * 1e-4 = budget exactly; 1.5e-4 gives 6e-4
@@ -150,8 +152,9 @@ def test_resume_after_a_stop_gives_the_same_allocation(tmp_path):
             allocate(FACTORY, problem(), settings(), store=tmp_path / "b", executor=ex, progress=False, stop_after=50)
         stopped_with = len(list((tmp_path / "b").glob("run_*.json")))
         resumed = allocate(FACTORY, problem(), settings(), store=tmp_path / "b", executor=ex, progress=False)
-    assert 50 <= stopped_with < whole.new_runs  # kept what ran, not everything
+    assert stopped_with == 50 < whole.new_runs  # exactly the runs asked, not everything
     assert resumed.new_runs == whole.new_runs - stopped_with
+    # exact: the same runs in index order, either in memory or read back from JSON (which keeps every bit)
     assert resumed.allocation_iterations == whole.allocation_iterations
     assert resumed.equal_iterations == whole.equal_iterations and resumed.front == whole.front
 
@@ -179,7 +182,7 @@ def test_contradictory_problems_are_refused():
         (["--joints", "A", "Q"], "--joints"),
         (["--output", "nope"], "--output nope"),
         (["--measure", "median"], "--measure median"),
-        (["--bounds", "A:0.2:0.1"], "contradict"),
+        (["--bounds", "A:0.2:0.1"], "--bounds A:0.2:0.1: joint A's lower bound 0.2 mm must be above 0 and below"),
         (["--bounds", "Z:0.1:0.2"], "'Z'"),
         (["--cost", "A:0:-1"], "cost b"),
         (["--levels-mm", "5"], "level"),

@@ -35,6 +35,10 @@ FAST_GUARDS = {
     "clearance.contact_calibration.store.calibrate_joint": "calibrate_joint",
     "clearance.retrofit.retrofit": "retrofit",
     "clearance.analysis.sweeps.robot_ranking.run_robot_ranking": "run_robot_ranking",
+    "clearance.analysis.design.allocation.allocate": "allocate",
+    "clearance.analysis.design.optimise.optimise_design": "optimise_design",
+    "clearance.run.retrofitted.simulate_retrofitted": "simulate_retrofitted",
+    "clearance.retrofit.add_backlash": "add_backlash",
 }
 """Everything that does work, by dotted path: a refused command must reach none of it."""
 
@@ -50,6 +54,18 @@ SCENARIOS = {
     "arm.xml": '<mujoco><worldbody><body name="arm"><joint name="elbow" axis="0 0 1"/>'
     '<geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01"/></body></worldbody>'
     '<actuator><motor joint="elbow"/></actuator></mujoco>',
+    "arm_limited.xml": '<mujoco><worldbody><body name="arm"><joint name="elbow" axis="0 0 1"/>'
+    '<geom type="capsule" fromto="0 0 0 0.2 0 0" size="0.01"/></body></worldbody>'
+    '<actuator><motor name="m" joint="elbow" ctrllimited="true" ctrlrange="-1 1"/></actuator></mujoco>',
+    "over.csv": "time_s,m\n0,0\n0.5,1\n1,1.5\n",
+    "neg_speed.toml": '[mechanism]\nbuilder = "slider_crank"\ncrank_speed_rpm = -3000\n',
+    "alloc_cost.toml": '[mechanism]\nbuilder = "slider_crank"\n\n[allocation.cost.crank_rod]\na = 0\nb = -1\n',
+    "alloc_extra.toml": '[mechanism]\nbuilder = "slider_crank"\n\n[allocation.foo]\nx = 1\n',
+    "opt_unknown.toml": '[mechanism]\nbuilder = "slider_crank"\n\n[optimise]\nbogus = 1\n',
+    "both_sections.toml": '[mechanism]\nbuilder = "slider_crank"\n\n[optimise]\nruns = 2\n\n[bogus]\nx = 1\n',
+    # a retrofit's record edited by hand: a negative time step
+    "rf_neg/retrofit.json": '{"format": 1, "model": "model.xml", "original": "original.xml", "timestep": -1e-6, '
+    '"original_timestep": 0.002, "contact_mode": "exact", "hinges": [], "qpos_map": [0], "qvel_map": [0]}',
 }
 
 FULL_FORM_EDITS = {
@@ -350,6 +366,175 @@ BATTERY: list[tuple[str, list[str], list[str]]] = [
         ["retrofit", "{tmp}/none.xml", "--joint", "elbow", "--out", "{tmp}/r"],
         ["none.xml does not exist"],
     ),
+    # the newer commands: allocate
+    ("allocate-no-budget", ["allocate"], ["--budget", "required"]),
+    ("allocate-joint-unknown", ["allocate", "--joints", "nosuch", "--budget", "100"], ["--joints", "nosuch"]),
+    (
+        "allocate-levels-sub-micron",
+        ["allocate", "--budget", "100", "--levels-mm", "0.0001", "0.05"],
+        ["--levels-mm 0.0001", "outside every joint's bounds"],
+    ),
+    (
+        "allocate-levels-twice",
+        ["allocate", "--budget", "100", "--levels-mm", "0.05", "0.05"],
+        ["--levels-mm 0.05", "twice"],
+    ),
+    (
+        "allocate-cost-negative",
+        ["allocate", "--budget", "100", "--cost", "crank_rod:1:-1"],
+        ["--cost crank_rod:1:-1", "crank_rod's cost b", "> 0"],
+    ),
+    (
+        "allocate-cost-joint-unknown",
+        ["allocate", "--budget", "100", "--cost", "nosuch:1:1"],
+        ["--cost nosuch:1:1", "'nosuch'"],
+    ),
+    (
+        "allocate-cost-in-scenario",
+        ["allocate", "--budget", "100", "--scenario", "{tmp}/alloc_cost.toml"],
+        ["alloc_cost.toml", "[allocation.cost.crank_rod]", "cost b"],
+    ),
+    (
+        "allocate-scenario-extra-table",
+        ["allocate", "--budget", "100", "--scenario", "{tmp}/alloc_extra.toml"],
+        ["alloc_extra.toml", "[allocation] takes only 'cost'"],
+    ),
+    (
+        "allocate-bounds-reversed",
+        ["allocate", "--budget", "100", "--bounds", "crank_rod:0.2:0.1"],
+        ["--bounds crank_rod:0.2:0.1", "lower bound 0.2 mm", "upper bound 0.1 mm"],
+    ),
+    (
+        "allocate-bounds-twice",
+        ["allocate", "--budget", "100", "--bounds", "crank_rod:0.05:0.1", "crank_rod:0.06:0.1"],
+        ["--bounds crank_rod:0.06:0.1", "give each joint once"],
+    ),
+    (
+        "allocate-bounds-below-a-micron",
+        ["allocate", "--budget", "100", "--bounds", "crank_rod:0.0001:0.1"],
+        ["--bounds crank_rod:0.0001:0.1", "smallest clearance accepted"],
+    ),
+    ("allocate-min-above-max", ["allocate", "--budget", "100", "--min-mm", "0.5"], ["--min-mm 0.5 --max-mm 0.3"]),
+    ("allocate-measure-unknown", ["allocate", "--budget", "100", "--measure", "median"], ["--measure median"]),
+    ("allocate-rpm-above-cap", ["allocate", "--budget", "100", "--rpm", "1e9"], ["--rpm", RPM_CAP]),
+    ("allocate-stop-after-0", ["allocate", "--budget", "100", "--stop-after", "0"], ["--stop-after", "> 0"]),
+    ("allocate-out-is-a-file", ["allocate", "--budget", "100", "--out", "{file}"], ["--out {file}", "is a file"]),
+    (
+        "allocate-out-name-too-long",
+        ["allocate", "--budget", "100", "--out", "{tmp}/o/" + "a" * 300 + "/x"],
+        ["--out", "300 bytes long", "one name"],
+    ),
+    # optimise
+    ("optimise-no-variable", ["optimise"], ["--vary"]),
+    ("optimise-vary-reversed", ["optimise", "--vary", "rod_length_mm=200:100"], ["--vary rod_length_mm=200:100"]),
+    (
+        "optimise-clearance-beyond-bearing",
+        ["optimise", "--vary", "rod_length_mm=100:200", "--clearance-mm", "20"],
+        ["--clearance-mm 20", "bearing_radius"],
+    ),
+    (
+        "optimise-clearance-thin-journal",
+        ["optimise", "--vary", "rod_length_mm=100:200", "--clearance-mm", "9.99"],
+        ["--clearance-mm 9.99", "journal of radius 0.01 mm"],
+    ),
+    (
+        "optimise-budget-below-samples",
+        ["optimise", "--vary", "rod_length_mm=100:200", "--samples", "2", "--budget", "3"],
+        ["--budget 3", "--samples + 2"],
+    ),
+    ("optimise-stroke-one-number", ["optimise", "--vary", "rod_length_mm=100:200", "--stroke", "5"], ["--stroke 5"]),
+    (
+        "optimise-scenario-unknown-option",
+        ["optimise", "--scenario", "{tmp}/opt_unknown.toml"],
+        ["opt_unknown.toml", "bogus"],
+    ),
+    (
+        "optimise-out-is-a-file",
+        ["optimise", "--vary", "rod_length_mm=100:200", "--out", "{file}"],
+        ["--out {file}", "is a file"],
+    ),
+    # a robot's ranking
+    (
+        "rank-model-frequency-1e9",
+        ["rank", "--model", "{tmp}/arm.xml", "--frequencies-hz", "1e9"],
+        ["--frequencies-hz 1e+09", "at most 50 Hz"],
+    ),
+    ("rank-model-amplitude-0", ["rank", "--model", "{tmp}/arm.xml", "--amplitudes", "0"], ["--amplitudes", "> 0"]),
+    # a retrofitted model's run
+    (
+        "run-model-with-clearance-mm",
+        ["run", "--model", "{dir}", "--clearance-mm", "0.2"],
+        ["--clearance-mm", "with --model the retrofit's model"],
+    ),
+    ("run-model-a-model-file", ["run", "--model", "{tmp}/arm.xml"], ["--model {tmp}/arm.xml", "retrofit it first"]),
+    ("run-model-missing", ["run", "--model", "{tmp}/none"], ["--model {tmp}/none", "does not exist"]),
+    ("run-model-empty-folder", ["run", "--model", "{dir}"], ["--model {dir}", "no retrofit.json"]),
+    (
+        "run-model-negative-time-step",
+        ["run", "--model", "{tmp}/rf_neg"],
+        ["--model {tmp}/rf_neg", "timestep must be a finite time step > 0", "-1e-06"],
+    ),
+    (
+        "run-model-control-and-sine",
+        ["run", "--model", "{dir}", "--control", "{tmp}/over.csv", "--sine-amplitude", "0.5"],
+        ["--control", "--sine-amplitude", "give one drive"],
+    ),
+    ("run-sine-without-model", ["run", "--sine-amplitude", "0.5"], ["--sine-amplitude", "give --model DIR too"]),
+    # retrofit
+    (
+        "retrofit-joint-key-twice",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow:clearance_mm=0.1,clearance_mm=0.2", "--out", "{tmp}/r"],
+        ["--joint 'elbow:clearance_mm=0.1,clearance_mm=0.2'", "clearance_mm is given twice"],
+    ),
+    (
+        "retrofit-joint-unknown-key",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow:foo=1", "--out", "{tmp}/r"],
+        ["'foo=1' is not key=value"],
+    ),
+    (
+        "retrofit-sine-amplitude-0",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow", "--out", "{tmp}/r", "--sine-amplitude", "0"],
+        ["--sine-amplitude", "> 0"],
+    ),
+    (
+        "retrofit-sine-beyond-ctrlrange",
+        ["retrofit", "{tmp}/arm_limited.xml", "--joint", "elbow", "--out", "{tmp}/r", "--sine-amplitude", "2"],
+        ["--sine-amplitude 2", "ctrlrange of m"],
+    ),
+    (
+        "retrofit-control-beyond-ctrlrange",
+        [
+            "retrofit",
+            "{tmp}/arm_limited.xml",
+            "--joint",
+            "elbow",
+            "--out",
+            "{tmp}/r",
+            "--sizing-control",
+            "{tmp}/over.csv",
+        ],
+        ["--sizing-control {tmp}/over.csv", "column 'm'", "1.5 at t = 1 s", "ctrlrange [-1, 1]"],
+    ),
+    (
+        "retrofit-out-name-too-long",
+        ["retrofit", "{tmp}/arm.xml", "--joint", "elbow", "--out", "{tmp}/o/" + "b" * 300],
+        ["--out", "300 bytes long"],
+    ),
+    # scenario files
+    (
+        "scenario-negative-speed",
+        ["run", "--scenario", "{tmp}/neg_speed.toml"],
+        ["neg_speed.toml, line 3", "crank_speed_rpm", "must be > 0"],
+    ),
+    (
+        "scenario-design-section-and-unknown-table",
+        ["run", "--scenario", "{tmp}/both_sections.toml"],
+        ["both_sections.toml", "'bogus'", "unknown key"],
+    ),
+    # the viewer
+    ("view-missing", ["view", "{tmp}/none.xml"], ["no such file or folder", "none.xml"]),
+    ("view-folder-without-model", ["view", "{dir}"], ["folder {dir} has no model.xml"]),
+    ("view-ideal-of-a-file", ["view", "--ideal", "{tmp}/arm.xml"], ["--ideal", "arm.xml is a file"]),
     # the command itself
     ("no-command", [], ["required: command"]),
     ("unknown-command", ["simulate"], ["invalid choice: 'simulate'"]),
@@ -440,6 +625,7 @@ def test_bad_input_battery(argv, words, tmp_path, monkeypatch, capsys, no_work):
     (tmp_path / "adir").mkdir()
     (tmp_path / "broken").symlink_to(tmp_path / "nowhere")
     for name, text in SCENARIOS.items():
+        (tmp_path / name).parent.mkdir(exist_ok=True)
         (tmp_path / name).write_text(text)
     (tmp_path / "binary.toml").write_bytes(b"\xff\xfe\x00[mechanism]")
     full = _full_form()
@@ -762,3 +948,58 @@ def test_an_unreadable_manifest_or_digest_says_how_to_recover(tmp_path):
         with pytest.warns(RuntimeWarning, match=r"a\.digest\.json is unreadable .* simulated again"):
             run_batch([spec], store, executor=ex, progress=False)
     assert RunStore(store).digest("a").status == "ok", RunStore(store).digest("a").error
+
+
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["allocate", "--joints", "crank_rod", "rod_slider", "--budget", "100", "--timestep-us", "1000"],
+        ["optimise", "--vary", "rod_length_mm=100:200", "--samples", "2", "--budget", "4", "--timestep-us", "1000"],
+    ],
+    ids=["allocate", "optimise"],
+)
+def test_a_time_step_every_run_would_refuse_is_one_line_naming_the_option(argv, tmp_path, capsys):
+    """The design tools prepare one model before their batch: a time step the contact cannot take is
+    refused once, naming --timestep-us, not reported as 'nan +- nan' or a traceback after every run failed."""
+    out = tmp_path / "o"
+    rc, _, err = _call([*argv, "--out", str(out), "--no-progress"], capsys)
+    assert rc == 2 and "Traceback" not in err, err
+    (line,) = err.strip().splitlines()
+    assert line.startswith("error: --timestep-us 1000: time step 0.001 s is too large") and "nan" not in line
+    assert not out.exists()  # refused before the folder was made
+
+
+def test_a_scenario_with_a_design_tools_section_runs_its_mechanism(tmp_path, capsys):
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(SCENARIOS["ok.toml"] + "\n[allocation.cost.crank_rod]\na = 1\nb = 2\n\n[optimise]\nruns = 4\n")
+    out = tmp_path / "out"
+    # 0.1 ms: the point is which parts of the file are read, not the run
+    rc, _, err = _call(["run", "--scenario", str(scenario), "--duration-ms", "0.1", "--out", str(out)], capsys)
+    assert rc == 0, err
+    assert err.strip() == (
+        f"note: --scenario {scenario}: [allocation] is for clearance allocate, [optimise] is for clearance "
+        "optimise; this command reads the mechanism"
+    )
+
+
+def test_a_sweep_resumed_with_other_settings_is_refused_naming_what_differs(tmp_path, capsys):
+    out = tmp_path / "s"
+    # one point of 2 periods at 5 us: a second or two; the point is the second command's refusal
+    argv = ["sweep", "--points", "1", "--start", "0.5", "--stop", "0.5", "--sampled", "1", "--workers", "1"]
+    assert _call([*argv, "--periods", "2", "--out", str(out), "--no-progress"], capsys)[0] == 0
+    rc, _, err = _call([*argv, "--periods", "3", "--out", str(out), "--no-progress"], capsys)
+    assert rc == 2 and "Traceback" not in err, err
+    (line,) = err.strip().splitlines()
+    assert str(out) in line and "duration" in line, line
+
+
+def test_a_stopped_run_says_so_at_the_head_of_its_report(tmp_path):
+    from clearance.cli.outputs import note_stop
+
+    report = tmp_path / "report.md"
+    report.write_text("# slider_crank\n")
+    note_stop(report, "simulation diverged at t = 1 ms")
+    assert report.read_text().splitlines()[0] == (
+        "**This run stopped before its end: simulation diverged at t = 1 ms. Every file here holds the run up to "
+        "that time.**"
+    )

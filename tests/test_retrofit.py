@@ -437,7 +437,7 @@ def test_cli_retrofits_the_reacher_calibrated(tmp_path, capsys):
     assert err.count("\n") == 1 and not out.exists()
     code, stdout, err = _cli([*argv, "--accept-inaccurate"], capsys)
     assert code == 0, err
-    assert "joint1: c = 0.2 mm, 32 segments" in stdout and "speed cost:" in stdout
+    assert "joint1: c = 200 µm, 32 segments" in stdout and "speed cost:" in stdout
     assert "warning: accuracy not met, kept with --accept-inaccurate: hinge 'joint1'" in stdout
     report = (out / "retrofit.md").read_text()
     for text in ("Planar play only: no tilt", "calibrated: ", "## Speed cost", "clr_joint1__x", "## Kept"):

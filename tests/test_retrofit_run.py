@@ -72,7 +72,7 @@ def test_cli_runs_the_model_and_its_twin_under_the_sinusoid(folder, tmp_path, ca
     ]
     code, stdout, err = _cli(argv, capsys)
     assert code == 0, err
-    assert "joint0: peak force" in stdout and "joint1: peak force" in stdout
+    assert "joint0, whole run: peak force" in stdout and "joint1, whole run: peak force" in stdout
     result = SimulationResult.load(out / "result")
     twin = SimulationResult.load(out / "ideal")
     h = load_retrofitted(folder).manifest.timestep

@@ -43,7 +43,14 @@ from typing import Any
 
 import numpy as np
 
-from clearance.analysis.design.ensemble import MEASURES, EnsembleResult, EnsembleSettings, run_ensembles
+from clearance.analysis.design.ensemble import (
+    MEASURES,
+    EnsembleResult,
+    EnsembleSettings,
+    EnsembleStopped,
+    require_some_run,
+    run_ensembles,
+)
 from clearance.analysis.design.surrogate import (
     CostModel,
     ResponseSurface,
@@ -307,6 +314,8 @@ class _Runner:
         ops = self.problem.operating_points
         pts = [self.point(c, op) for c in designs for op in ops]
         before = len(list(self.store.glob("run_*.json")))
+        if self.remaining is not None and self.remaining <= 0:  # the last batch used up stop_after
+            raise EnsembleStopped(f"stopped after {self.new} runs", self.new)
         try:
             res = run_ensembles(
                 self.make,
@@ -318,11 +327,15 @@ class _Runner:
                 progress=self.progress,
                 stop_after=self.remaining,
             )
+        except EnsembleStopped:
+            made = len(list(self.store.glob("run_*.json"))) - before
+            raise EnsembleStopped(f"stopped after {self.new + made} runs", self.new + made) from None
         finally:
             made = len(list(self.store.glob("run_*.json"))) - before
             self.new += made
             if self.remaining is not None:
-                self.remaining = max(1, self.remaining - made)
+                self.remaining -= made
+        require_some_run(res)  # a batch where nothing ran says why, not "nan +- nan"
         self.total += len(pts) * runs
         return [res[i * len(ops) : (i + 1) * len(ops)] for i in range(len(designs))]
 

@@ -59,6 +59,7 @@ __all__ = [
     "EnsembleResult",
     "EnsembleSettings",
     "EnsembleStopped",
+    "EveryRunFailed",
     "MeasureSummary",
     "RunEvaluator",
     "RunMeasures",
@@ -67,6 +68,7 @@ __all__ = [
     "run_ensemble",
     "run_ensembles",
     "simulated_measures",
+    "require_some_run",
 ]
 
 MEASURES = ("mean_deviation", "rms_deviation", "peak_deviation", "peak_force")
@@ -203,6 +205,25 @@ class EnsembleResult:
         if not self.runs:
             return float("nan")
         return float(np.count_nonzero(self.values(measure) <= budget) / len(self.runs))
+
+
+class EveryRunFailed(ValueError):
+    """Every run of a batch failed: what the runs share (the time step, the contact), not a design, is at fault.
+
+    The message is the runs' own error, once (the first run's), so the setting it names can be
+    changed.
+    """
+
+
+def require_some_run(results: Sequence[EnsembleResult]) -> None:
+    """Raise `EveryRunFailed` when not one run of ``results`` finished.
+
+    Raises:
+        EveryRunFailed: every run failed; the message gives how many and the first run's error.
+    """
+    runs = [r for e in results for r in e.runs]
+    if runs and all(r.status != "ok" for r in runs):
+        raise EveryRunFailed(f"every one of the {len(runs)} runs failed; the first: {runs[0].error}")
 
 
 class EnsembleStopped(RuntimeError):
@@ -364,9 +385,8 @@ def run_ensembles(
             nothing kept.
         executor, scheduler_address, max_workers: as `open_executor`.
         progress: show a progress bar of runs.
-        stop_after: stop once this many runs have been simulated in this call (those
-            running are waited for and kept), raising `EnsembleStopped`; to interrupt a
-            batch on purpose.
+        stop_after: simulate exactly this many runs in this call (no more are started), then
+            raise `EnsembleStopped`; to interrupt a batch on purpose.
 
     Returns:
         One `EnsembleResult` per point, in order.
@@ -446,7 +466,12 @@ def _run_tasks(
 
         stopped = False
         while True:
-            while not stopped and len(in_flight) < 2 * pool.slots:
+            # never more in flight than stop_after leaves: the stop comes after exactly that many runs
+            while (
+                not stopped
+                and len(in_flight) < 2 * pool.slots
+                and (stop_after is None or done + len(in_flight) < stop_after)
+            ):
                 i = next(queue, None)
                 if i is None:
                     break

@@ -65,6 +65,7 @@ class DesignEstimate:
         runs: runs that gave a value, over all conditions.
         failed: runs that failed.
         wall_time_s: simulated runs' wall time, summed [s] (NaN for runs read from the store).
+        error: the first failed run's error ('' when none failed).
     """
 
     value: float
@@ -73,6 +74,7 @@ class DesignEstimate:
     runs: int
     failed: int
     wall_time_s: float
+    error: str = ""
 
 
 def combine(
@@ -89,7 +91,8 @@ def combine(
     runs = sum(len(e.runs) - len(e.failed) for e in ensembles)
     failed = sum(len(e.failed) for e in ensembles)
     wall = float(np.nansum([r.wall_time_s for e in ensembles for r in e.runs]))
-    return DesignEstimate(value, se, tuple(rows), runs, failed, wall)
+    error = next((r.error for e in ensembles for r in e.failed), "")
+    return DesignEstimate(value, se, tuple(rows), runs, failed, wall, error)
 
 
 @dataclass
@@ -158,7 +161,8 @@ class EnsembleObjective:
             if est is None:
                 out.append(Estimate(math.nan, math.nan, False, check.reason))
             elif est.failed:
-                out.append(Estimate(math.nan, math.nan, False, f"{est.failed} of {est.runs + est.failed} runs failed"))
+                failed = f"{est.failed} of {est.runs + est.failed} runs failed"
+                out.append(Estimate(math.nan, math.nan, False, f"{failed}: {est.error}" if est.error else failed))
             else:
                 out.append(Estimate(est.value, est.se, True))
         return out

@@ -34,7 +34,7 @@ import numpy as np
 
 from clearance.analysis.design.optimise_space import unit_sample
 
-__all__ = ["BatchObjective", "Estimate", "SearchResult", "SearchSettings", "Trial", "minimise"]
+__all__ = ["BatchObjective", "Estimate", "NoFeasibleDesign", "SearchResult", "SearchSettings", "Trial", "minimise"]
 
 
 @dataclass(frozen=True)
@@ -128,6 +128,10 @@ class SearchResult:
         return sum(t.estimate.feasible for t in self.trials)
 
 
+class NoFeasibleDesign(ValueError):
+    """No design the search evaluated was feasible; the message gives the designs' reasons (a run's error)."""
+
+
 class _BudgetSpent(Exception):
     pass
 
@@ -189,7 +193,7 @@ def minimise(
 
     Raises:
         ValueError: bounds or start of the wrong length, or the start outside the bounds.
-        RuntimeError: no evaluated design was feasible.
+        NoFeasibleDesign: no evaluated design was feasible (a `ValueError`).
     """
     from scipy.optimize import minimize
 
@@ -235,6 +239,6 @@ def minimise(
 def _best(trials: Sequence[Trial]) -> Trial:
     ok = [t for t in trials if t.estimate.feasible and math.isfinite(t.estimate.value)]
     if not ok:
-        notes = {t.estimate.note for t in trials if t.estimate.note}
-        raise RuntimeError(f"no evaluated design was feasible ({'; '.join(sorted(notes)) or 'no reason given'})")
+        notes = sorted({t.estimate.note for t in trials if t.estimate.note})
+        raise NoFeasibleDesign(f"no evaluated design was feasible ({'; '.join(notes[:3]) or 'no reason given'})")
     return min(ok, key=lambda t: t.estimate.value)

@@ -115,7 +115,11 @@ def figures_in_parallel(processes: int = 2) -> Iterator[None]:
     if child is None:
         _draw_all(jobs, processes)
         return
-    _draw_all(jobs, 1)  # the figures only this process can draw first, then help with the child's
+    try:
+        _draw_all(jobs, 1)  # the figures only this process can draw first, then help with the child's
+    except BaseException:  # (a full disk): the child is waited for, so it writes nothing after this
+        child.abandon()
+        raise
     child.finish()
 
 

@@ -31,7 +31,7 @@ from clearance.analysis.figures.report_sections import (
 )
 from clearance.analysis.metrics.lag import OutputLag, joint_lag
 from clearance.analysis.metrics.response import window_peaks
-from clearance.analysis.metrics.statistics import deviation_statistics, drive_period
+from clearance.analysis.metrics.statistics import DeviationStatistics, deviation_statistics, drive_period
 from clearance.results import ENERGY_TERMS, SimulationResult, atomic_write_text
 from clearance.units import format_quantity
 
@@ -238,13 +238,12 @@ def _deviation_lines(
     except ValueError as err:  # fewer than 3 samples in the window
         return lines + [f"No deviation statistics: {err}.", ""]
     draw(plot_deviation, result, ideal, output, st, path=out / "deviation.png")
-    lines += ["| statistic | value |", "|---|---:|"]
-    lines += [f"| {k} | {_g(v) if isinstance(v, float) else v} |" for k, v in st.as_dict().items()]
-    what = (
-        "the steady state (the start-up window skipped)"
-        if window.has_steady_state and window.startup > 0
-        else "the whole run (no steady state)"
-    )
+    steady = window.has_steady_state and window.startup > 0
+    what = "the steady state (the start-up window skipped)" if steady else "the whole run (no steady state)"
+    span = f"{'steady state' if steady else 'whole run'}, {_q(st.window_start, 's')}–{_q(st.window_end, 's')}"
+    lines += [f"| statistic of d = {output} − ideal ({span}) | value |", "|---|---:|"]
+    unit = "rad" if "angle" in output else "m"  # as the response figure tells an angle from a position
+    lines += [f"| {label} | {text} |" for label, text in _deviation_rows(st, unit)]
     lines += [
         "",
         f"Window from t = {_q(st.window_start, 's')}: {what}. Samples are autocorrelated: compare p-values "
@@ -254,6 +253,39 @@ def _deviation_lines(
         "",
     ]
     return lines
+
+
+_DEVIATION_LABELS = {
+    "n": ("samples", None),
+    "window_start": ("window start", "s"),
+    "window_end": ("window end", "s"),
+    "mean_deviation": ("mean deviation (mean of the absolute d)", "out"),
+    "mean_signed_deviation": ("mean signed deviation (mean of d)", "out"),
+    "rms_deviation": ("RMS deviation", "out"),
+    "max_deviation": ("largest absolute deviation", "out"),
+    "band90": ("90 % tolerance band (90th percentile of the absolute d)", "out"),
+    "band90_low": ("5th percentile of d", "out"),
+    "band90_high": ("95th percentile of d", "out"),
+    "t_statistic": ("paired t statistic", None),
+    "t_pvalue": ("paired t-test p-value", None),
+    "f_statistic": ("variance ratio F = var(y) / var(ideal)", None),
+    "f_pvalue": ("F-test p-value", None),
+    "ks_statistic": ("Kolmogorov–Smirnov distance", None),
+    "ks_pvalue": ("Kolmogorov–Smirnov p-value", None),
+}
+"""Each deviation statistic's label in the report, and its unit ("out": the output's own)."""
+
+
+def _deviation_rows(st: DeviationStatistics, unit: str) -> list[tuple[str, str]]:
+    """(label, value with its unit) of each deviation statistic, in `_DEVIATION_LABELS`' order."""
+    rows = []
+    for key, value in st.as_dict().items():
+        label, kind = _DEVIATION_LABELS.get(key, (key, None))
+        if kind is None:
+            rows.append((label, _g(value) if isinstance(value, float) else str(value)))
+        else:
+            rows.append((label, _q(value, unit if kind == "out" else kind)))
+    return rows
 
 
 def write_report(

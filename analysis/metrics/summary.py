@@ -29,8 +29,8 @@ class JointSummary:
         impacts: number of contact onsets (penetration crossing zero upwards).
         contact_fraction: fraction of samples in contact [-].
         max_penetration: largest penetration [m].
-        output_rms_deviation: RMS of (output - ideal output) of the first output [m or
-            rad] (NaN without an ideal result).
+        output_rms_deviation: RMS of (output - ideal output) of the first output over the
+            whole run [m or rad] (NaN without an ideal result).
         startup_window: the start-up window [s] (the first period of the slowest prescribed
             drive): the ``steady_*`` values are taken after it; 0 when none was asked for.
         steady_peak_force, steady_p95_force, steady_impacts, steady_contact_fraction,
@@ -38,6 +38,9 @@ class JointSummary:
             the start-up window, where the journal released from the bearing centre makes
             its first, largest impacts); NaN (impacts -1) when the run is no longer than
             the window.
+        steady_output_rms_deviation: the RMS deviation of the first output over the steady
+            state only [m or rad], the one the report and ``deviation.png`` give; NaN
+            without an ideal result or a steady state.
     """
 
     joint: str
@@ -54,6 +57,7 @@ class JointSummary:
     steady_impacts: int = -1
     steady_contact_fraction: float = float("nan")
     steady_max_penetration: float = float("nan")
+    steady_output_rms_deviation: float = float("nan")
 
     @property
     def has_steady_state(self) -> bool:
@@ -61,22 +65,44 @@ class JointSummary:
         return self.steady_impacts >= 0
 
 
-def rms_deviation(result: SimulationResult, ideal: SimulationResult, output: str) -> float:
-    """RMS of result - ideal for one output, the ideal interpolated on the result's times."""
-    ref = np.interp(result.times, ideal.times, ideal.outputs[output])
-    return float(np.sqrt(np.mean((result.outputs[output] - ref) ** 2)))
+def rms_deviation(result: SimulationResult, ideal: SimulationResult, output: str, *, since: float = 0.0) -> float:
+    """RMS of result - ideal for one output, the ideal interpolated on the result's times.
+
+    Args:
+        result: a run.
+        ideal: its ideal twin's run.
+        output: the output's name.
+        since: only the samples at or after this time [s] (0: the whole run).
+
+    Returns:
+        The RMS deviation [the output's unit]; NaN when no sample is at or after ``since``.
+    """
+    k0 = int(np.searchsorted(result.times, since)) if since > 0 else 0
+    if k0 >= len(result.times):
+        return float("nan")
+    times = result.times[k0:]
+    ref = np.interp(times, ideal.times, ideal.outputs[output])
+    return float(np.sqrt(np.mean((result.outputs[output][k0:] - ref) ** 2)))
 
 
 def joint_summary(
-    result: SimulationResult, joint: str, *, deviation: float = float("nan"), startup: float = 0.0
+    result: SimulationResult,
+    joint: str,
+    *,
+    deviation: float = float("nan"),
+    startup: float = 0.0,
+    steady_deviation: float = float("nan"),
 ) -> JointSummary:
     """Contact statistics of ``joint`` (see `JointSummary`).
 
     Args:
         result: a run.
         joint: name of one of its clearance joints.
-        deviation: RMS deviation of the output from ideal, carried into the summary [m or rad].
+        deviation: RMS deviation of the output from ideal over the whole run, carried into the
+            summary [m or rad].
         startup: start-up window [s]; > 0 adds the steady-state statistics after it.
+        steady_deviation: the same over the steady state [m or rad], carried into the summary
+            where the run has a steady state.
 
     Returns:
         The joint's `JointSummary`.
@@ -112,6 +138,7 @@ def joint_summary(
         steady_impacts=s_impacts,
         steady_contact_fraction=s_fraction,
         steady_max_penetration=s_pen,
+        steady_output_rms_deviation=steady_deviation if s_impacts >= 0 else float("nan"),
     )
 
 
@@ -126,8 +153,14 @@ def summarise(
         startup: start-up window [s]; > 0 adds each joint's steady-state statistics after it.
     """
     outputs = [k for k in result.outputs if not k.endswith(("_vel", "_acc"))]
-    dev = rms_deviation(result, ideal, outputs[0]) if (ideal is not None and outputs) else float("nan")
-    return [joint_summary(result, j, deviation=dev, startup=startup) for j in result.joints]
+    nan = float("nan")
+    dev = rms_deviation(result, ideal, outputs[0]) if (ideal is not None and outputs) else nan
+    steady = (
+        rms_deviation(result, ideal, outputs[0], since=startup)
+        if (ideal is not None and outputs and startup > 0)
+        else nan
+    )
+    return [joint_summary(result, j, deviation=dev, startup=startup, steady_deviation=steady) for j in result.joints]
 
 
 def write_summary_csv(rows: list[JointSummary], path: str | Path) -> Path:

@@ -21,7 +21,7 @@ from __future__ import annotations
 import functools
 from collections.abc import Callable, Mapping, Sequence
 from concurrent.futures import Executor
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -168,6 +168,8 @@ class CriticalityRanking:
         failed: (point, error) of points that did not run.
         output: name of the measured output ('' when not known).
         output_kind: its `OutputKind` (None when not known); sets the units.
+        complete: every point of the grid has run (False: stopped by ``stop_after``, the
+            ranking is of the points run so far).
     """
 
     scores: tuple[JointScore, ...]
@@ -175,6 +177,7 @@ class CriticalityRanking:
     failed: tuple[tuple[dict[str, Any], str], ...] = ()
     output: str = ""
     output_kind: OutputKind | None = None
+    complete: bool = True
 
     @property
     def score_unit(self) -> str:
@@ -349,4 +352,4 @@ def run_criticality(
         evaluation=SweepEvaluation(output=output, ideal=True),
         max_workers=max_workers,
     )
-    return rank_joints(out.rows, output=measured, output_kind=kinds[measured])
+    return replace(rank_joints(out.rows, output=measured, output_kind=kinds[measured]), complete=out.complete)

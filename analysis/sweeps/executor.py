@@ -4,8 +4,8 @@
 a Dask cluster's when a scheduler address is given (its client is closed on exit), or a
 local process pool with the ``spawn`` context (shut down on exit, pending work cancelled).
 Sweep callables must be picklable (module-level functions or `functools.partial`), since
-every point runs in another process. `Progress` is a tqdm bar, or nothing when progress is
-off.
+every point runs in another process. `Progress` is a tqdm bar on a terminal, a line every few
+seconds elsewhere (`clearance.progress`), or nothing when progress is off.
 
 The local pool's workers never outlive the process that started them: each watches its
 parent's pid from a thread and exits when the parent is gone (killed with SIGKILL, say, when
@@ -27,7 +27,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
-    from tqdm import tqdm
+    from clearance.progress import ProgressDisplay
 
 __all__ = [
     "PARENT_POLL_S",
@@ -152,7 +152,7 @@ def open_executor(
 
 
 class Progress:
-    """A progress bar (tqdm) of finished tasks; does nothing when disabled or empty.
+    """A progress display of finished tasks (`clearance.progress.progress_bar`); nothing when disabled or empty.
 
     Use as a context manager; `step` counts finished tasks and shows a short label.
     """
@@ -160,11 +160,11 @@ class Progress:
     def __init__(
         self, total: int, *, enabled: bool = True, desc: str = "runs", unit: str = "run", initial: int = 0
     ) -> None:
-        self._bar: tqdm | None = None
+        self._bar: ProgressDisplay | None = None
         if enabled and total:
-            from tqdm import tqdm
+            from clearance.progress import progress_bar
 
-            self._bar = tqdm(total=total, initial=initial, unit=unit, desc=desc, smoothing=0.1)
+            self._bar = progress_bar(total, initial=initial, unit=unit, desc=desc, smoothing=0.1)
 
     def __enter__(self) -> Progress:
         return self

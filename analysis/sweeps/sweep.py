@@ -406,9 +406,9 @@ def run_sweep(
         executor: executor to use (not shut down here).
         scheduler_address: Dask scheduler address; its client's executor is used.
         progress: show a tqdm progress bar (points done, rate, time remaining).
-        stop_after: stop submitting points once this many have finished in this call;
-            points already running then are waited for and written too, so no computed
-            point is lost (the rest resume on the next call).
+        stop_after: finish exactly this many points in this call, then stop (no more are
+            submitted than it leaves: none is computed beyond it); the rest resume on the
+            next call.
         evaluation: picklable callable (result, ideal result or None, mechanism) -> row
             fields; default `SweepEvaluation()`. It gets the ideal run when its attribute
             ``ideal`` is true (or absent).
@@ -488,12 +488,12 @@ def _run_window(
 ) -> None:
     """Keep ``window`` points in flight (twice the slots, so workers never wait) until done or stopped.
 
-    Every finished point is saved, also those finishing together with a stop; points already
-    running at a stop cannot be cancelled, so they are waited for and saved too.
+    Every finished point is saved. With ``stop_after`` no more points are submitted than it
+    leaves (finished + in flight <= stop_after), so the stop comes after exactly that many.
     """
     try:
         while True:
-            while len(in_flight) < window:
+            while len(in_flight) < window and (stop_after is None or finished_count() + len(in_flight) < stop_after):
                 i = next(queue, None)
                 if i is None:
                     break

@@ -74,7 +74,14 @@ _SUBPARSERS = (
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the `clearance` command."""
-    p = argparse.ArgumentParser(prog="clearance", description=(__doc__ or "").split("\n\n")[0])
+    from clearance.cli.parser import CommandParser, version_text
+
+    p = CommandParser(
+        prog="clearance",
+        description="Mechanisms with joint clearance in MuJoCo: simulate, sweep, rank, size and retrofit. "
+        "Each command's options: clearance COMMAND --help.",
+    )
+    p.add_argument("--version", action="version", version=version_text())
     sub = p.add_subparsers(dest="command", required=True)
     for name, (_, _, text) in _OWN_PARSER.items():
         sub.add_parser(name, help=f"{text} (see 'clearance {name} --help')", add_help=False)
@@ -98,8 +105,9 @@ def _show_warning(
 def main(argv: list[str] | None = None) -> int:
     """Entry point of the `clearance` console script; returns the process exit status.
 
-    Exit statuses: 0 done, 1 some sweep points failed, 2 refused (bad input) or stopped by
-    an error, 3 a sweep stopped early (resumable), 130 interrupted with Ctrl-C.
+    Exit statuses: 0 done, 1 some sweep points failed or a fault during the work (a full disk),
+    2 refused (bad input) or stopped by an error, 3 stopped early by --stop-after (resumable),
+    130 interrupted with Ctrl-C.
     """
     if argv is None:  # the console script: the process ends with the command
         # at exit, Python's last garbage collections walk every object still alive (0.2 s after a
@@ -114,6 +122,12 @@ def main(argv: list[str] | None = None) -> int:
         except KeyboardInterrupt:
             print("interrupted", file=sys.stderr)
             return 130
+        except OSError as err:  # met while writing (bad paths are refused before any work)
+            from clearance.cli.messages import FAULT, error
+            from clearance.cli.paths import write_fault
+
+            error(f"{write_fault(err)}; no file of this command reads as finished (a resumable one keeps what has run)")
+            return FAULT
 
 
 def _dispatch(argv: list[str]) -> int:
@@ -121,7 +135,11 @@ def _dispatch(argv: list[str]) -> int:
         module, func, _ = _OWN_PARSER[argv[0]]
         entry: Callable[[list[str]], int] = getattr(importlib.import_module(module), func)
         return entry(argv[1:])
-    args = build_parser().parse_args(argv)
+    parser = build_parser()
+    args, extra = parser.parse_known_args(argv)
+    if extra:  # refused by the command's own parser, so the line names the command
+        commands = next(a for a in parser._actions if isinstance(a, argparse._SubParsersAction)).choices
+        commands[args.command].error(f"unrecognized arguments: {' '.join(extra)}")
     command: Callable[[argparse.Namespace], int] = args.run_command
     try:
         return command(args)

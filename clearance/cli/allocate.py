@@ -21,6 +21,7 @@ command reuses them and gives the same allocation.
 from __future__ import annotations
 
 import argparse
+import math
 import shlex
 import sys
 from collections.abc import Sequence
@@ -28,10 +29,21 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from clearance.cli.arg_types import bounded, positive, rpm_option
+from clearance.cli.limits import MIN_CLEARANCE
 from clearance.cli.options import add_sweep_args, si, sweep_options
-from clearance.cli.paths import check_folder, folder_lock
+from clearance.cli.parser import CommandParser
+from clearance.cli.paths import check_folder, folder_lock, staged_outputs
 from clearance.cli.scenario_sections import split_section
-from clearance.cli.sweep_common import INTERRUPTED, UsageError, catalogue_entry, check_scheduler, probe, usage_error
+from clearance.cli.sweep_common import (
+    INTERRUPTED,
+    UsageError,
+    catalogue_entry,
+    check_prepares,
+    check_scheduler,
+    probe,
+    stopped,
+    usage_error,
+)
 from clearance.model import JointType, Mechanism, OutputKind
 
 if TYPE_CHECKING:
@@ -46,11 +58,11 @@ MEASURE_NAMES = {"mean": "mean_deviation", "rms": "rms_deviation", "peak": "peak
 
 def allocate_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance allocate``."""
-    p = argparse.ArgumentParser(
+    p = CommandParser(
         prog="clearance allocate",
         description="Allocate the cheapest clearance per joint whose output deviation stays within a budget.",
     )
-    p.add_argument("--scenario", default=None, help="scenario file (.toml), instead of --mechanism")
+    p.add_argument("--scenario", default=None, help="scenario file (.toml), instead of --mechanism (default: none)")
     p.add_argument(
         "--joints", nargs="+", default=None, help="joints given a clearance (default: criticality candidates)"
     )
@@ -59,17 +71,37 @@ def allocate_parser() -> argparse.ArgumentParser:
     budget = p.add_mutually_exclusive_group(required=True)
     budget.add_argument(
         "--budget", type=positive(float, "--budget"), nargs="+", default=None,
-        help="budget [µm for a position output, µrad for an angle]: one, or one per --rpm",
+        help="budget [µm for a position output, µrad for an angle]: one, or one per --rpm (this or --budget-equal-mm "
+        "is required)",
     )  # fmt: skip
     budget.add_argument(
         "--budget-equal-mm", type=positive(float, "--budget-equal-mm"), default=None,
-        help="budget = the verified mean of the design with every joint at this clearance [mm]",
+        help="budget = the verified mean of the design with every joint at this clearance [mm] (this or --budget "
+        "is required)",
     )  # fmt: skip
-    p.add_argument("--rpm", type=rpm_option("--rpm"), nargs="+", default=None, help="drive speeds [rpm]")
+    p.add_argument(
+        "--rpm",
+        type=rpm_option("--rpm"),
+        nargs="+",
+        default=None,
+        help="drive speeds [rpm] (default: the mechanism's own speed)",
+    )
     p.add_argument("--min-mm", type=positive(float, "--min-mm"), default=0.02, help="lower bound [mm] (default 0.02)")
     p.add_argument("--max-mm", type=positive(float, "--max-mm"), default=0.3, help="upper bound [mm] (default 0.3)")
-    p.add_argument("--bounds", nargs="+", default=[], metavar="JOINT:LO:HI", help="bounds of one joint [mm]")
-    p.add_argument("--cost", nargs="+", default=[], metavar="JOINT:A:B", help="cost a + b/c[mm] of one joint")
+    p.add_argument(
+        "--bounds",
+        nargs="+",
+        default=[],
+        metavar="JOINT:LO:HI",
+        help="bounds of one joint [mm] (default: --min-mm and --max-mm)",
+    )
+    p.add_argument(
+        "--cost",
+        nargs="+",
+        default=[],
+        metavar="JOINT:A:B",
+        help="cost a + b/c[mm] of one joint (default a = 0, b = 1)",
+    )
     p.add_argument("--levels-mm", type=positive(float, "--levels-mm"), nargs="+", default=None,
                    help="allowed clearances [mm] (a grid; default continuous)")  # fmt: skip
     p.add_argument("--target-share", type=bounded(float, "--target-share", 0.01, 1.0), default=0.9,
@@ -82,11 +114,17 @@ def allocate_parser() -> argparse.ArgumentParser:
                    help="drive periods per run, the first not measured (default 4)")  # fmt: skip
     p.add_argument("--design-size", type=bounded(int, "--design-size", 4), default=None,
                    help="design points (default twice the surrogate's terms plus 3)")  # fmt: skip
-    p.add_argument("--design-runs", type=positive(int, "--design-runs"), default=2, help="runs per design point")
-    p.add_argument("--iterations", type=positive(int, "--iterations"), default=4, help="verifications at most")
+    p.add_argument(
+        "--design-runs", type=positive(int, "--design-runs"), default=2, help="runs per design point (default 2)"
+    )
+    p.add_argument(
+        "--iterations", type=positive(int, "--iterations"), default=4, help="verifications at most (default 4)"
+    )
     p.add_argument("--front", type=positive(float, "--front"), nargs="+", default=[0.5, 0.7, 1.0, 1.4, 2.0],
-                   help="budgets of the front, as fractions of the budget")  # fmt: skip
-    p.add_argument("--front-runs", type=positive(int, "--front-runs"), default=5, help="runs per front design")
+                   help="budgets of the front, as fractions of the budget (default 0.5 0.7 1 1.4 2)")  # fmt: skip
+    p.add_argument(
+        "--front-runs", type=positive(int, "--front-runs"), default=5, help="runs per front design (default 5)"
+    )
     add_sweep_args(p, "allocate")
     p.set_defaults(mechanism=None)
     return p
@@ -95,8 +133,8 @@ def allocate_parser() -> argparse.ArgumentParser:
 def main_allocate(argv: Sequence[str] | None = None) -> int:
     """Run ``clearance allocate``; writes ``allocation.md``, tables and figures; returns the exit code.
 
-    Exit codes: 0 the allocation meets the target share, 1 it does not (or stopped by
-    --stop-after), 2 a usage error (also a budget the lower bounds miss), 130 interrupted.
+    Exit codes: 0 the allocation meets the target share, 1 it does not, 2 a usage error (also a
+    budget the lower bounds miss), 3 stopped by --stop-after (rerun to resume), 130 interrupted.
     """
     args = allocate_parser().parse_args(argv)
     command = "clearance allocate " + shlex.join(list(argv) if argv is not None else sys.argv[1:])
@@ -116,14 +154,16 @@ def main_allocate(argv: Sequence[str] | None = None) -> int:
             title = f"{name}, {problem.measure.replace('_', ' ')} of {settings.verification.output}"
             from clearance.analysis.design.allocation_report import write_allocation
 
-            write_allocation(a, out, title=title, unit=unit, scale=scale, command=command)
+            with staged_outputs(out) as stage:  # the report, tables and figures together, or none
+                write_allocation(a, stage, title=title, unit=unit, scale=scale, command=command)
     except BudgetUnreachable as err:
         return usage_error(f"--budget: {err}")
     except (UsageError, ValueError) as err:
         return usage_error(str(err))
     except EnsembleStopped as err:
-        print(f"{err}; the runs are kept in {out / 'runs'}: rerun the same command to resume", file=sys.stderr)
-        return 1
+        return stopped(
+            args.stop_after, f"{err.finished} runs", out / "runs", "allocation.md and its tables are written"
+        )
     except KeyboardInterrupt:
         kept = len(list((out / "runs").glob("run_*.json"))) if (out / "runs").is_dir() else 0
         print(f"interrupted; {kept} runs kept in {out / 'runs'}, rerun to resume", file=sys.stderr)
@@ -232,7 +272,7 @@ def _problem(
         raise UsageError(f"--budget: give one value or one per --rpm ({len(ops)}); got {len(args.budget)}")
     lower, upper = _bounds(args, joints)
     cost = _cost(args, joints)
-    levels = tuple(si(v, "mm") for v in args.levels_mm) if args.levels_mm else None
+    levels = _levels(args, lower, upper)
     budgets = None
     if args.budget is not None:
         budgets = tuple(b / scale for b in (args.budget * len(ops) if len(args.budget) == 1 else args.budget))
@@ -256,8 +296,10 @@ def _problem(
     for op in ops:
         for side, c in (("--min-mm", lower), ("--max-mm", upper)):
             pt = {"clearances": dict(zip(joints, c, strict=True)), **op}
-            probe(make, pt, name, source=f"{name} with {side} bounds {[x * 1e3 for x in c]} mm at {op or 'its speed'}",
-                  periods=args.periods, timestep=options.timestep)  # fmt: skip
+            where = f"{name} with {side} bounds {[x * 1e3 for x in c]} mm at {op or 'its speed'}"
+            mech = probe(make, pt, name, source=where, periods=args.periods, timestep=options.timestep)
+            if side == "--min-mm":  # the stiffest contact: the time step every run shares is checked once
+                check_prepares(mech, options, where, f"--timestep-us {args.timestep_us:g}")
     settings = AllocationSettings(
         verification=EnsembleSettings(
             runs=args.runs, spread=args.spread, seed=args.seed, periods=args.periods, output=output, options=options
@@ -292,17 +334,45 @@ def _bounds(args: argparse.Namespace, joints: tuple[str, ...]) -> tuple[tuple[fl
     """Bounds per joint [m] from --min-mm/--max-mm and --bounds JOINT:LO:HI [mm]."""
     lo = {j: args.min_mm for j in joints}
     hi = {j: args.max_mm for j in joints}
+    given = dict.fromkeys(joints, f"--min-mm {args.min_mm:g} --max-mm {args.max_mm:g}")
     for text in args.bounds:
         j, a, b = _split(text, "--bounds", 3)
         if j not in lo:
             raise UsageError(f"--bounds {text}: joint {j!r} is not one of --joints {list(joints)}")
+        if given[j].startswith("--bounds"):
+            raise UsageError(f"--bounds {text}: joint {j!r} has bounds already ({given[j]}); give each joint once")
         lo[j], hi[j] = _number(a, "--bounds", text), _number(b, "--bounds", text)
+        given[j] = f"--bounds {text}"
+    smallest = MIN_CLEARANCE * 1e3
     for j in joints:
         if not 0 < lo[j] < hi[j]:
             raise UsageError(
-                f"bounds of joint {j}: lower {lo[j]:g} mm and upper {hi[j]:g} mm contradict; expected 0 < lower < upper"
+                f"{given[j]}: joint {j}'s lower bound {lo[j]:g} mm must be above 0 and below its upper bound "
+                f"{hi[j]:g} mm"
+            )
+        if lo[j] < smallest:
+            raise UsageError(
+                f"{given[j]}: joint {j}'s lower bound {lo[j]:g} mm is below the smallest clearance accepted, "
+                f"{smallest:g} mm (1 µm)"
             )
     return tuple(si(lo[j], "mm") for j in joints), tuple(si(hi[j], "mm") for j in joints)
+
+
+def _levels(args: argparse.Namespace, lower: tuple[float, ...], upper: tuple[float, ...]) -> tuple[float, ...] | None:
+    """--levels-mm [m], each within some joint's bounds (none is dropped without a word)."""
+    if not args.levels_mm:
+        return None
+    lo_mm, hi_mm = min(lower) * 1e3, max(upper) * 1e3
+    for v in args.levels_mm:
+        if not any(a * (1 - 1e-12) <= si(v, "mm") <= b * (1 + 1e-12) for a, b in zip(lower, upper, strict=True)):
+            raise UsageError(
+                f"--levels-mm {v:g}: outside every joint's bounds (from {lo_mm:g} to {hi_mm:g} mm; --min-mm, "
+                "--max-mm, --bounds); give levels within them"
+            )
+    twice = sorted({v for v in args.levels_mm if args.levels_mm.count(v) > 1})
+    if twice:
+        raise UsageError(f"--levels-mm {twice[0]:g} is given twice")
+    return tuple(si(v, "mm") for v in args.levels_mm)
 
 
 def _cost(args: argparse.Namespace, joints: tuple[str, ...]) -> Any:
@@ -315,6 +385,7 @@ def _cost(args: argparse.Namespace, joints: tuple[str, ...]) -> Any:
     extra = sorted(set(table) - {"cost"})
     if extra:
         raise UsageError(f"--scenario {args.scenario}: [allocation] takes only 'cost' tables (got {extra})")
+    source = {j: "the default cost a = 0, b = 1" for j in joints}
     for j, entry in dict(table.get("cost", {})).items():
         where = f"--scenario {args.scenario}: [allocation.cost.{j}]"
         if j not in a:
@@ -326,12 +397,19 @@ def _cost(args: argparse.Namespace, joints: tuple[str, ...]) -> Any:
                 if not isinstance(entry[key], (int, float)) or isinstance(entry[key], bool):
                     raise UsageError(f"{where}: {key} must be a number (got {entry[key]!r})")
                 store[j] = float(entry[key])
+        source[j] = where
     for text in args.cost:
         j, x, y = _split(text, "--cost", 3)
         if j not in a:
             raise UsageError(f"--cost {text}: joint {j!r} is not one of --joints {list(joints)}")
         a[j], b[j] = _number(x, "--cost", text), _number(y, "--cost", text)
+        source[j] = f"--cost {text}"
+    for j in joints:  # each joint's own refusal, naming where its values came from
+        if not (math.isfinite(a[j]) and a[j] >= 0):
+            raise UsageError(f"{source[j]}: joint {j}'s fixed cost a must be finite and >= 0 (got {a[j]:g})")
+        if not (math.isfinite(b[j]) and b[j] > 0):
+            raise UsageError(f"{source[j]}: joint {j}'s cost b (of b/c[mm]) must be finite and > 0 (got {b[j]:g})")
     try:
         return CostModel(tuple(a[j] for j in joints), tuple(b[j] for j in joints))
     except ValueError as err:
-        raise UsageError(str(err)) from None
+        raise UsageError(f"--cost: {err}") from None

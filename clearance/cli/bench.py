@@ -15,6 +15,7 @@ from collections.abc import Sequence
 
 from clearance.bench.scenarios import default_scenarios, write_report
 from clearance.bench.speed_error import run_speed_error
+from clearance.cli.parser import CommandParser
 from clearance.cli.paths import FolderBusyError, check_folder, folder_lock
 from clearance.cli.sweep_common import INTERRUPTED
 
@@ -23,7 +24,12 @@ __all__ = ["bench_parser", "main_bench"]
 
 def bench_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance bench``."""
-    p = argparse.ArgumentParser(prog="clearance bench", description=__doc__.split("\n\n")[0])
+    p = CommandParser(
+        prog="clearance bench",
+        description="Speed against error of MuJoCo settings (time step, segments, geoms, contact mode) against "
+        "the reference solver on four scenarios; a table, the Pareto front and a figure (resumable; --quick: a "
+        "small grid in minutes).",
+    )
     p.add_argument("--out", default="clearance-bench", help="output folder (default clearance-bench); rerun to resume")
     p.add_argument("--quick", action="store_true", help="small grid and short runs (minutes)")
     p.add_argument("--scenarios", nargs="*", default=None, metavar="NAME", help="scenarios to run (default all)")
@@ -39,7 +45,8 @@ def bench_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="PATTERN",
         help="only the settings whose key matches one of these shell patterns (e.g. 'exact_*' "
-        "'calibrated_h2us_Nrule_*'; keys as in the output folder's file names); the reference always runs",
+        "'calibrated_h2us_Nrule_*'; keys as in the output folder's file names; default: every setting); the "
+        "reference always runs",
     )
     p.add_argument("--workers", type=int, default=None, help="processes for the accuracy runs (default: CPU count)")
     p.add_argument("--no-progress", action="store_true", help="no progress bars")

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import argparse
+import time
 from collections.abc import Sequence
+from pathlib import Path
 
 import numpy as np
 
@@ -14,7 +16,8 @@ from clearance.cli.options import (
     mechanism_from_args,
     options_from_args,
 )
-from clearance.cli.paths import check_folder, folder_lock
+from clearance.cli.parser import CommandParser
+from clearance.cli.paths import check_folder, folder_lock, staged_outputs
 from clearance.model import Mechanism
 from clearance.options import ContactMode, ModelOptions
 
@@ -23,7 +26,7 @@ __all__ = ["calibrate_parser", "main_calibrate"]
 
 def calibrate_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance calibrate``."""
-    p = argparse.ArgumentParser(
+    p = CommandParser(
         prog="clearance calibrate",
         description="Fit the MuJoCo contact of every clearance joint of a scenario to LN impacts, at the "
         "sizing 'clearance run' uses (effective mass: median over the ideal cycle, with its "
@@ -91,10 +94,12 @@ def main_calibrate(argv: Sequence[str] | None = None) -> int:
 
 def _calibrate(args: argparse.Namespace, mech: Mechanism, options: ModelOptions) -> None:
     """Calibrate every clearance joint of ``mech`` and write its report in ``args.out``."""
+    from clearance.cli.outputs import calibration_lines
     from clearance.contact_calibration.report import calibration_report
     from clearance.contact_calibration.store import calibrate_joint
     from clearance.run.preparation import prepare
 
+    started = time.time()
     prep = prepare(mech, options)
     speeds = np.geomspace(args.speeds[0], args.speeds[1], args.n_speeds or 8) if args.speeds else None
     for j in mech.clearance_joints:
@@ -102,15 +107,22 @@ def _calibrate(args: argparse.Namespace, mech: Mechanism, options: ModelOptions)
         result, path = calibrate_joint(
             j, ring, prep.sizing[j.name], options, speeds=speeds, use_cache=not args.no_cache
         )
-        files = calibration_report(
-            result,
-            j.require_clearance(),
-            ring,
-            options,
-            out_dir=args.out,
-            stem=f"calibration_{j.name}",
-            title=f"Contact calibration: {j.name}",
-            source=str(path) if path else None,
-        )
-        print(files.markdown.read_text())
-        print(f"wrote {files.markdown} and {files.plot}")
+        with staged_outputs(Path(args.out)) as stage:  # the table and its plot together, or neither
+            files = calibration_report(
+                result,
+                j.require_clearance(),
+                ring,
+                options,
+                out_dir=stage,
+                stem=f"calibration_{j.name}",
+                title=f"Contact calibration: {j.name}",
+                source=str(path) if path else None,
+            )
+            print(files.markdown.read_text())
+        print(f"wrote {Path(args.out) / files.markdown.name} and {Path(args.out) / files.plot.name}")
+        if path is None:
+            where = "not stored (--no-cache)" if args.no_cache else "not stored (the cache folder cannot be written)"
+            print(f"{j.name}: contact calibration fitted now, {where}")
+        else:
+            for line in calibration_lines({j.name: {"source": f"calibrated: {path}"}}, started):
+                print(line.strip())

@@ -1,13 +1,16 @@
-"""How the commands report a refusal or an error: one line on stderr, exit status 2."""
+"""How the commands report a refusal or a fault: one line on stderr, exit status 2 or 1."""
 
 from __future__ import annotations
 
 import sys
 
-__all__ = ["USAGE_ERROR", "error", "one_line"]
+__all__ = ["FAULT", "USAGE_ERROR", "error", "one_line"]
 
 USAGE_ERROR = 2
 """Exit status of a command refused (bad input) or stopped by an error."""
+
+FAULT = 1
+"""Exit status of a command stopped by a fault during its work (a full disk, a folder gone read-only)."""
 
 
 def one_line(text: str) -> str:

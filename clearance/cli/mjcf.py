@@ -27,6 +27,14 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     m.add_argument("--ideal", action="store_true", help="write the ideal twin instead")
     # the portable ring model unless the compiled-contact one is asked for by name
     m.set_defaults(run_command=command, contact_mode=ContactMode.CALIBRATED.value)
+    for action in m._actions:  # the shared help names the run's default (exact): say this command's
+        if action.dest == "contact_mode" and action.help:
+            action.help = (
+                "contact model (default calibrated here: the portable ring of segments, fitted to LN impacts "
+                "and cached, which stock MuJoCo opens anywhere; 'clearance run' defaults to exact): exact (the "
+                "compiled plugin's exact contact; the model then needs this package installed; 'exact_ln' is the "
+                "same), calibrated or nominal (the ring with formula parameters)"
+            )
 
 
 def command(args: argparse.Namespace) -> int:

@@ -30,12 +30,13 @@ import time
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import TYPE_CHECKING, Any, NoReturn
+from typing import TYPE_CHECKING, Any
 
 from clearance.cli.arg_types import bounded, positive, rpm_option, timestep_option
 from clearance.cli.optimise_scenario import ScenarioDesign, read_scenario_design, section_vary
 from clearance.cli.options import CONTACT_MODES, DEFAULT_MECHANISM, check_clearance_at, contact_mode_from_args, si
-from clearance.cli.sweep_common import INTERRUPTED, UsageError, catalogue_entry, usage_error
+from clearance.cli.parser import CommandParser
+from clearance.cli.sweep_common import INTERRUPTED, UsageError, catalogue_entry, check_prepares, usage_error
 from clearance.units import UNITS, quantity_of
 
 if TYPE_CHECKING:  # the analysis is imported when the command runs, not when it is parsed
@@ -52,17 +53,9 @@ _OBJECTIVES = ("rms_deviation", "mean_deviation", "peak_deviation", "peak_force"
 _VARY = re.compile(r"^(?P<key>[A-Za-z_][A-Za-z0-9_]*)(?:\[(?P<index>[0-9]+)\])?=(?P<bounds>.*)$")
 
 
-class _Parser(argparse.ArgumentParser):
-    """An argument parser whose refusals are one line on stderr and exit status 2."""
-
-    def error(self, message: str) -> NoReturn:
-        usage_error(f"clearance optimise: {message} (see 'clearance optimise --help')")
-        sys.exit(2)
-
-
 def optimise_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance optimise``."""
-    p = _Parser(
+    p = CommandParser(
         prog="clearance optimise",
         description="Size design variables of a mechanism for the lowest output deviation or bearing force "
         "with clearance, averaged over start-state ensembles; confirm the optimum with fresh runs.",
@@ -75,7 +68,8 @@ def optimise_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="TOML",
         help="scenario file naming a catalogue builder, with an [optimise] section of these options (its "
-        "[optimise.vary] table: KEY = [LOW, HIGH(, START)]); options given here win over the file's",
+        "[optimise.vary] table: KEY = [LOW, HIGH(, START)]); options given here win over the file's (default: "
+        "none, --mechanism and the options given)",
     )
     p.add_argument(
         "--vary",
@@ -98,7 +92,7 @@ def optimise_parser() -> argparse.ArgumentParser:
         default=None,
         metavar="LOW:HIGH",
         help="limits of the output's stroke over a cycle, mm for a position output, deg for an angle output "
-        "(either side may be left empty)",
+        "(either side may be left empty; default: no limit)",
     )
     p.add_argument(
         "--clearance-mm",
@@ -152,14 +146,25 @@ def optimise_parser() -> argparse.ArgumentParser:
     p.add_argument(
         "--timestep-us", type=timestep_option(), default=None, help="time step [µs] (default the contact mode's)"
     )
-    p.add_argument("--contact-mode", default=None, metavar="MODE", help=f"one of {', '.join(CONTACT_MODES)}")
+    p.add_argument(
+        "--contact-mode",
+        default=None,
+        metavar="MODE",
+        help=f"contact model of every run, one of {', '.join(CONTACT_MODES)} (default exact; see 'clearance run "
+        "--help')",
+    )
     p.add_argument(
         "--out", default=None, help="output folder (default clearance-optimise-<mechanism>); rerun to resume"
     )
     p.add_argument(
         "--workers", type=positive(int, "--workers"), default=None, help="local worker processes (default CPU count)"
     )
-    p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="Dask scheduler address")
+    p.add_argument(
+        "--scheduler",
+        default=None,
+        metavar="ADDRESS",
+        help="Dask scheduler address (default: local processes; needs pip install 'dask[distributed]')",
+    )
     p.add_argument("--no-progress", action="store_true", help="no line per design")
     return p
 
@@ -395,10 +400,17 @@ def _plan(args: argparse.Namespace) -> _Plan:
     out = check_folder(args.out or f"clearance-optimise-{args.mechanism}")
     check_scheduler(args.scheduler)
     fixed: dict[str, Any] = dict(design.keywords) if design else {}
+    given = f"--mechanism {args.mechanism}"
     if args.clearance_mm is not None:
         fixed["radial_clearance"] = si(args.clearance_mm, "mm")
+        given = f"--clearance-mm {args.clearance_mm:g}"
     if args.clearance_at is not None:
         fixed["clearance_at"] = tuple(args.clearance_at)
+    if "radial_clearance" in fixed:  # the clearance alone, at the builder's own design, before any variable
+        try:
+            check_mechanism(entry.builder(**fixed), given)
+        except ValueError as err:
+            raise UsageError(err if str(err).startswith(given) else f"{given}: {err}") from None
     factory = DesignFactory(entry.builder, fixed, tuple(names))
     variables = tuple(DesignVariable(n, lo, hi) for n, lo, hi, _ in parsed)
     start = {n: s for n, _, _, s in parsed if s is not None}
@@ -432,10 +444,12 @@ def _plan(args: argparse.Namespace) -> _Plan:
     )
     for cond in conditions:
         mech = factory({**x0, **cond})
-        check_mechanism(mech, f"--mechanism {args.mechanism}")
+        check_mechanism(mech, given)
         if mech.drive_period is None:
             raise UsageError(f"--mechanism {args.mechanism}: it has no drive period to run ensembles over")
         check_steps(args.periods * mech.drive_period, options.timestep, f"--periods {args.periods}")
+        step = "the default time step" if args.timestep_us is None else f"--timestep-us {args.timestep_us:g}"
+        check_prepares(mech, options, f"--mechanism {args.mechanism} at the start design {_design(x0)}", step)
     first = check_design(factory, {**x0, **conditions[0]}, output=output, stroke=stroke)
     if not first.feasible:
         scan_bounds(factory, variables, output=output, stroke=stroke)  # refuses bounds where nothing is feasible
@@ -472,9 +486,8 @@ def _optimise(args: argparse.Namespace, plan: _Plan) -> int:
     """The optimisation of a checked plan, its confirmation and its report; the exit status."""
     from clearance.analysis.design.optimise import optimise_design
     from clearance.analysis.design.optimise_figure import plot_convergence
-    from clearance.analysis.design.optimise_report import optimise_markdown, write_optimise_report
     from clearance.analysis.sweeps.executor import SchedulerError
-    from clearance.cli.paths import folder_lock
+    from clearance.cli.paths import folder_lock, staged_outputs
 
     out: Path = plan.out
     scale, unit = (1e6, "µrad") if plan.angular and args.objective != "peak_force" else (1e6, "µm")
@@ -525,22 +538,11 @@ def _optimise(args: argparse.Namespace, plan: _Plan) -> int:
                 f"{last[0]:.1f} s; confirmation in {search_s - last[0]:.1f} s",
                 flush=True,
             )
-            reports = _design_runs(plan, result, out)
-            print(f"run reports in {time.perf_counter() - t0 - search_s:.1f} s", flush=True)
-            plot_convergence(result, out / "convergence.png", scale=scale, unit=unit)
-            stroke_scale, stroke_unit = (180 / math.pi, "deg") if plan.angular else (1e3, "mm")
-            md = optimise_markdown(
-                result,
-                title=f"Design optimisation of {args.mechanism} with clearance",
-                scale=scale,
-                unit=unit,
-                stroke_scale=stroke_scale,
-                stroke_unit=stroke_unit,
-                command=args.command_line,
-                reports=reports,
-                wall_time_s=search_s,
-            )
-            write_optimise_report(out, result, md)
+            with staged_outputs(out) as stage:  # every report and figure, or none
+                reports = _design_runs(plan, result, stage)
+                print(f"run reports in {time.perf_counter() - t0 - search_s:.1f} s", flush=True)
+                plot_convergence(result, stage / "convergence.png", scale=scale, unit=unit)
+                _write_summary(args, plan, result, stage, reports, scale, unit, search_s)
     except SchedulerError as err:
         return usage_error(f"--scheduler {args.scheduler}: {err}")
     c = result.confirmation
@@ -550,6 +552,34 @@ def _optimise(args: argparse.Namespace, plan: _Plan) -> int:
         f"standard errors; {time.perf_counter() - t0:.0f} s; wrote {out / 'optimise.md'}"
     )
     return 0
+
+
+def _write_summary(
+    args: argparse.Namespace,
+    plan: _Plan,
+    result: OptimisationResult,
+    out: Path,
+    reports: list[tuple[str, str]],
+    scale: float,
+    unit: str,
+    search_s: float,
+) -> None:
+    """Write ``optimise.md`` and its JSON into ``out``."""
+    from clearance.analysis.design.optimise_report import optimise_markdown, write_optimise_report
+
+    stroke_scale, stroke_unit = (180 / math.pi, "deg") if plan.angular else (1e3, "mm")
+    md = optimise_markdown(
+        result,
+        title=f"Design optimisation of {args.mechanism} with clearance",
+        scale=scale,
+        unit=unit,
+        stroke_scale=stroke_scale,
+        stroke_unit=stroke_unit,
+        command=args.command_line,
+        reports=reports,
+        wall_time_s=search_s,
+    )
+    write_optimise_report(out, result, md)
 
 
 def _design_runs(plan: _Plan, result: OptimisationResult, out: Path) -> list[tuple[str, str]]:

@@ -102,7 +102,7 @@ def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, cont
         default=None,
         metavar="TOML",
         help="scenario file (a catalogue builder with overrides, or a whole mechanism); "
-        "replaces --mechanism and the options below (giving both is refused)",
+        "replaces --mechanism and the options below (giving both is refused; default: none)",
     )
     add_clearance_mm(g)
     g.add_argument(
@@ -199,7 +199,8 @@ def mechanism_from_args(args: argparse.Namespace) -> Mechanism:
 
 def _scenario_from_args(args: argparse.Namespace) -> Mechanism:
     """The mechanism of ``--scenario``, refusing the options it replaces."""
-    from clearance.builders import load_scenario
+    from clearance.builders import ScenarioError, load_scenario
+    from clearance.builders.scenario import loads_scenario
 
     given = [
         o
@@ -227,6 +228,18 @@ def _scenario_from_args(args: argparse.Namespace) -> Mechanism:
         return load_scenario(path)
     except OSError as err:
         raise ValueError(f"--scenario {path}: cannot read it ({err.strerror or type(err).__name__})") from None
+    except ScenarioError as err:
+        from clearance.cli.scenario_sections import DESIGN_SECTIONS, split_section
+
+        if err.key not in DESIGN_SECTIONS:
+            raise
+        section = str(err.key)
+    # a section of a design tool beside the mechanism: this command runs the mechanism, and says so
+    split = split_section(path, section)
+    found = [s for s in DESIGN_SECTIONS if s in split.document]
+    tools = ", ".join(f"[{s}] is for {DESIGN_SECTIONS[s]}" for s in found)
+    print(f"note: --scenario {path}: {tools}; this command reads the mechanism", file=sys.stderr)
+    return loads_scenario(split.scenario_text, source=str(path))
 
 
 def _catalogue_from_args(args: argparse.Namespace) -> Mechanism:
@@ -341,6 +354,10 @@ def add_clearance_mm(p: argparse.ArgumentParser | argparse._ArgumentGroup, *, wh
     )
 
 
+_STOP_UNITS = {"sweep": "points", "rank": "points (one joint, clearance and speed each)", "allocate": "simulated runs"}
+"""What --stop-after counts in each command."""
+
+
 def add_sweep_args(p: argparse.ArgumentParser, command: str) -> None:
     """Options every sweep command takes: mechanism, numerics, executor, output, progress."""
     from clearance.builders import CATALOGUE
@@ -381,7 +398,8 @@ def add_sweep_args(p: argparse.ArgumentParser, command: str) -> None:
         "--stop-after",
         type=positive(int, "--stop-after"),
         default=None,
-        help="stop after this many points (for allocate: simulated runs); rerun the command to resume",
+        help=f"stop after exactly this many {_STOP_UNITS.get(command, 'points')} have finished (exit status 3; "
+        "none is computed beyond them; the same command again resumes; default: no stop)",
     )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
 

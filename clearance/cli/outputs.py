@@ -3,17 +3,32 @@
 from __future__ import annotations
 
 import argparse
+import math
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from clearance.model import Mechanism, OutputKind
+from clearance.result_units import result_units
 from clearance.results import SimulationResult
+from clearance.units import format_quantity
 
 if TYPE_CHECKING:
     from clearance.analysis.metrics.reactions import ReactionSummary
+    from clearance.analysis.metrics.summary import JointSummary
 
-__all__ = ["write_outputs", "duration_from_args", "duration_source", "check_output_paths"]
+__all__ = [
+    "write_outputs",
+    "writing_outputs",
+    "note_stop",
+    "console_lines",
+    "calibration_lines",
+    "duration_from_args",
+    "duration_source",
+    "check_output_paths",
+]
 
 
 def check_output_paths(args: argparse.Namespace) -> Path:
@@ -30,72 +45,187 @@ def check_output_paths(args: argparse.Namespace) -> Path:
     return out
 
 
+@contextmanager
+def writing_outputs(out: Path, rerun: str | None) -> Iterator[tuple[Path, Path | None]]:
+    """Where a run writes its files: a private folder and a hidden recording path, published together.
+
+    The files go into a private folder beside ``out`` (`clearance.cli.paths.staged_outputs`) and
+    the recording, if asked for, to a hidden name beside ``rerun``; when the block ends without
+    an error the files move into ``out`` and the recording takes its name. A block that fails
+    (a full disk, a fault) leaves neither: no file that looks like a finished run.
+
+    Args:
+        out: the output folder (exists; locked).
+        rerun: the recording's path (``--rerun``), or None.
+
+    Yields:
+        (the folder to write the files in, the path to write the recording to or None).
+    """
+    from clearance.cli.paths import staged_outputs
+
+    final = None if not rerun else Path(rerun).resolve()
+    tmp = None if final is None else final.with_name(f".partial-{os.getpid()}-{final.name}")
+    try:
+        with staged_outputs(out) as stage:
+            yield stage, tmp
+        if final is not None and tmp is not None and tmp.exists():
+            os.replace(tmp, final)
+            print(f"  rerun recording written to {final} (open it with: rerun {final})")
+    finally:
+        if tmp is not None:
+            tmp.unlink(missing_ok=True)
+
+
+def note_stop(report: Path, stopped: str) -> None:
+    """Put a run's stop at the head of its report, so the files of a stopped run never read as finished."""
+    text = report.read_text(encoding="utf-8") if report.exists() else ""
+    head = f"**This run stopped before its end: {stopped}. Every file here holds the run up to that time.**\n\n"
+    report.write_text(head + text, encoding="utf-8")
+
+
 def write_outputs(
-    args: argparse.Namespace, mech: Mechanism, result: SimulationResult, ideal: SimulationResult, out: Path
+    args: argparse.Namespace,
+    mech: Mechanism,
+    result: SimulationResult,
+    ideal: SimulationResult,
+    out: Path,
+    *,
+    recording: Path | None = None,
+    stopped: str | None = None,
 ) -> None:
     """Write arrays, summary and reactions CSVs, the Markdown report with its figures (and a rerun recording).
 
     Args:
-        args: the command's options (``rerun``: a recording path or None).
+        args: the command's options.
         mech: the mechanism that ran.
         result: its run.
         ideal: the ideal twin's run.
-        out: output folder (exists).
+        out: output folder (exists; `writing_outputs`' private folder).
+        recording: where to write the rerun recording, or None for none.
+        stopped: why the run stopped before its end (its result is the part before), or None;
+            said in ``result.json`` (``stopped``) and at the head of ``report.md``.
     """
     from clearance.analysis.figures.report import write_report
     from clearance.analysis.metrics.reactions import summarise_reactions, write_reactions_csv
     from clearance.analysis.metrics.summary import summarise, write_summary_csv
 
+    angular = [o.name for o in mech.outputs if o.kind is OutputKind.ANGLE]
+    for run in (result, ideal):  # every array's and number's unit, in the files themselves
+        run.metadata["units"] = result_units(run.arrays(), angular)
+    if stopped is not None:
+        result.metadata["stopped"] = stopped
     result.save(out / "result")
     ideal.save(out / "ideal")
     period = mech.drive_period
     # the start-up window (the first drive period) for every statistic, section and figure; the
     # report says when a run is no longer; a mechanism driven by torques alone has none
     skip = period or 0.0
-    if getattr(args, "rerun", None):
+    if recording is not None:
         from clearance.analysis.figures.report import joint_sections
         from clearance.analysis.recording.rerun_log import record
 
         # the report's Poincaré sections (t = kT of the drive, after the same transient)
         sections = joint_sections(result, skip=skip)
-        rrd = Path(record(result, mech, args.rerun, ideal=ideal, poincare=sections)).resolve()
-        print(f"  rerun recording written to {rrd} (open it with: rerun {rrd})")
+        record(result, mech, recording, ideal=ideal, poincare=sections)
     rows = summarise(result, ideal, startup=period or 0.0)
     write_summary_csv(rows, out / "summary.csv")
     reactions = summarise_reactions(result, ideal, startup=skip)
     write_reactions_csv(reactions, out / "reactions.csv")
     # the figures in two processes where there are two CPUs (each drawn once, the child waited for)
     write_report(out, result, ideal, skip=skip, processes=2 if (os.cpu_count() or 1) >= 2 else 1, reactions=reactions)
-    output = mech.outputs[0].name
-    angular = mech.outputs[0].kind is OutputKind.ANGLE
+    if stopped is not None:
+        note_stop(out / "report.md", stopped)
+    for line in console_lines(mech, rows, reactions):
+        print(line)
+
+
+def console_lines(mech: Mechanism, rows: list[JointSummary], reactions: list[ReactionSummary]) -> list[str]:
+    """The run's numbers for the console: contact per joint, reaction peaks, the output's deviation.
+
+    Every number is in the unit its size calls for (`clearance.units.format_quantity`: 45.9 kN,
+    252 µs), and every statistic says whether it is over the whole run or the steady state.
+
+    Args:
+        mech: the mechanism that ran (its first output is the one measured).
+        rows: `summarise`'s rows, one per clearance joint.
+        reactions: `summarise_reactions`' rows.
+    """
+    q = format_quantity
+    lines = []
     for r in rows:
         if not r.max_penetration > 0:  # penetration = |e| - c never above 0: the journal never touched
-            print(
-                f"  {r.joint}: no contact (the journal stayed at least {-r.max_penetration * 1e6:.3g} µm "
-                "from the bearing)"
+            lines.append(
+                f"  {r.joint}: no contact (the journal stayed at least {q(-r.max_penetration, 'm')} from the bearing)"
             )
             continue
-        print(
-            f"  {r.joint}, whole run: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, "
-            f"p95 {r.p95_force:.4g} N, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
-            f"max penetration {r.max_penetration * 1e6:.3g} µm"
+        lines.append(
+            f"  {r.joint}, whole run: peak force {q(r.peak_force, 'N', digits=4)} at {q(r.peak_force_time, 's')}, "
+            f"p95 {q(r.p95_force, 'N', digits=4)}, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "
+            f"max penetration {q(r.max_penetration, 'm')}"
         )
-        window = f"the start-up window (the first drive period, {r.startup_window * 1e3:.3g} ms)"
+        window = f"the start-up window (the first drive period, {q(r.startup_window, 's')})"
         if r.has_steady_state:
-            print(
-                f"  {r.joint}, steady state after {window}: peak force {r.steady_peak_force:.4g} N, "
-                f"p95 {r.steady_p95_force:.4g} N, {r.steady_impacts} impacts, "
-                f"in contact {r.steady_contact_fraction:.1%}, max penetration {r.steady_max_penetration * 1e6:.3g} µm"
+            lines.append(
+                f"  {r.joint}, steady state after {window}: peak force {q(r.steady_peak_force, 'N', digits=4)}, "
+                f"p95 {q(r.steady_p95_force, 'N', digits=4)}, {r.steady_impacts} impacts, "
+                f"in contact {r.steady_contact_fraction:.1%}, max penetration {q(r.steady_max_penetration, 'm')}"
             )
         elif r.startup_window > 0:
-            print(f"  {r.joint}: no steady state: the run is no longer than its start-up window ({window})")
+            lines.append(f"  {r.joint}: no steady state: the run is no longer than {window}")
     joints = [r for r in reactions if r.kind == "joint"]
     if joints:
-        loads = ", ".join(f"{r.name} {_peak(r) / 1e3:.3g} kN" for r in joints)
-        print(f"  joint reactions, {'steady-state' if joints[0].has_steady_state else 'whole-run'} peaks: {loads}")
+        loads = ", ".join(f"{r.name} {q(_peak(r), 'N')}" for r in joints)
+        lines.append(
+            f"  joint reactions, {'steady-state' if joints[0].has_steady_state else 'whole-run'} peaks: {loads}"
+        )
     if rows:
-        unit, scale = ("rad", 1.0) if angular else ("mm", 1e3)
-        print(f"  {output}: RMS deviation from ideal {rows[0].output_rms_deviation * scale:.4g} {unit}")
+        output = mech.outputs[0].name
+        unit = "rad" if mech.outputs[0].kind is OutputKind.ANGLE else "m"
+        r = rows[0]
+        text = f"  {output}: RMS deviation from ideal {q(r.output_rms_deviation, unit, digits=4)} over the whole run"
+        if r.has_steady_state and math.isfinite(r.steady_output_rms_deviation):
+            text += (
+                f", {q(r.steady_output_rms_deviation, unit, digits=4)} in the steady state (after "
+                f"{q(r.startup_window, 's')}, as the report gives it)"
+            )
+        lines.append(text)
+    return lines
+
+
+def calibration_lines(contact: dict[str, dict[str, object]], started: float) -> list[str]:
+    """Whether each ring's calibration was fitted by this command or reused from the cache, and where.
+
+    Args:
+        contact: the prepared model's per-joint contact metadata (``source``: ``calibrated:
+            <file>`` for a calibrated ring, ``calibrated: not cached`` where the cache folder
+            could not be written).
+        started: when the command began preparing its models (`time.time`): a file written
+            since was fitted now.
+
+    Returns:
+        One line per calibrated joint (none for the exact contact or the nominal ring).
+    """
+    import datetime
+
+    lines = []
+    for joint, meta in contact.items():
+        source = str(meta.get("source", ""))
+        if not source.startswith("calibrated: "):
+            continue
+        where = source.removeprefix("calibrated: ")
+        if where == "not cached":
+            lines.append(f"  {joint}: contact calibration fitted now, not stored (the cache folder cannot be written)")
+            continue
+        try:
+            fitted = os.stat(where).st_mtime
+        except OSError:
+            fitted = started
+        if fitted >= started - 1.0:  # written by this command (1 s: file systems' time resolution)
+            lines.append(f"  {joint}: contact calibration fitted now and stored in {where} (later runs reuse it)")
+        else:
+            when = datetime.datetime.fromtimestamp(fitted).strftime("%Y-%m-%d %H:%M")
+            lines.append(f"  {joint}: contact calibration reused from {where} (fitted {when})")
+    return lines
 
 
 def _peak(r: ReactionSummary) -> float:

@@ -6,6 +6,11 @@ may not write in, a read-only file system -- with one line naming the option, th
 why, before anything is simulated. They probe by creating (and at once removing) a hidden
 temporary entry, so what they report is what the file system does, for any user.
 
+`staged_outputs` gives a command a private folder beside its output folder to write into; the
+files move into the output folder only when every one of them was written, so a run that
+fails half-way (a full disk, a fault) leaves no file that looks finished, and an earlier run's
+files stay whole.
+
 `folder_lock` holds an exclusive lock on ``<folder>/.clearance.lock`` while a command writes
 there, so that two commands never mix their files in one folder: the second is refused with
 the holder's pid, host, start time and command line. A command replaces only the files it
@@ -15,8 +20,10 @@ folder the command created is removed again when the command stops before writin
 
 from __future__ import annotations
 
+import errno
 import json
 import os
+import shutil
 import socket
 import sys
 import tempfile
@@ -25,7 +32,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-__all__ = ["LOCK_NAME", "FolderBusyError", "check_file", "check_folder", "folder_lock"]
+__all__ = ["LOCK_NAME", "FolderBusyError", "check_file", "check_folder", "folder_lock", "staged_outputs", "write_fault"]
 
 LOCK_NAME = ".clearance.lock"
 """The lock file a command holds in its output folder while it writes there."""
@@ -142,10 +149,28 @@ def _check_creatable(p: Path, folder: Path, option: str) -> None:
     a = _existing_ancestor(folder)
     if not a.is_dir():
         raise ValueError(f"{option} {p}: {a} is a file, not a folder, so no folder can be made under it")
+    _check_lengths(p, a, option)
     try:
         _probe_create(a)
     except OSError as err:
         raise ValueError(f"{option} {p}: cannot create a folder in {a} ({_why(err)})") from None
+
+
+def _check_lengths(p: Path, ancestor: Path, option: str) -> None:
+    """Refuse a path whose missing part has a name, or which as a whole is, longer than the file system allows."""
+    try:
+        name_max = os.pathconf(ancestor, "PC_NAME_MAX")
+        path_max = os.pathconf(ancestor, "PC_PATH_MAX")
+    except (OSError, ValueError):  # the system does not say: the probe and the writes will
+        return
+    for part in p.relative_to(ancestor).parts if p.is_relative_to(ancestor) else p.parts:
+        if len(os.fsencode(part)) > name_max:
+            raise ValueError(
+                f"{option} {p}: the name '{part[:24]}...' is {len(os.fsencode(part))} bytes long, more than the "
+                f"{name_max} the file system allows for one name"
+            )
+    if len(os.fsencode(os.path.abspath(p))) >= path_max:
+        raise ValueError(f"{option} {p}: the path is longer than the {path_max} bytes the file system allows")
 
 
 def _holder_text(fd: int) -> str:
@@ -197,7 +222,9 @@ def folder_lock(folder: Path, option: str = "--out") -> Iterator[Path]:
         FolderBusyError: another command holds the lock (a `ValueError`); nothing was
             written or created.
 
-    Where the system has no ``fcntl`` (Windows), the folder is created and not locked.
+    Where the system has no ``fcntl`` (Windows), the folder is created and not locked. An
+    `OSError` raised in the block without a file name (a full disk met by a buffered write) gets
+    ``folder`` as its ``filename``, so the message names where the command was writing.
     """
     import importlib.util
 
@@ -228,11 +255,71 @@ def folder_lock(folder: Path, option: str = "--out") -> Iterator[Path]:
     try:
         yield folder
         ok = True
+    except OSError as err:  # a system error that did not say where (a full disk): the folder
+        if err.filename is None and err.errno is not None:
+            err.filename = str(folder)
+        raise
     finally:
         lock.unlink(missing_ok=True)  # while still held: a later command creates a new one
         os.close(fd)
         if not ok:
             _remove_empty(missing)
+
+
+def _stage_folder(folder: Path) -> Path:
+    """A new private folder beside ``folder`` (the same parent, so relative paths from it are the same),
+    or inside it where its parent cannot be written."""
+    try:
+        return Path(tempfile.mkdtemp(prefix=f".{folder.name}.partial-", dir=folder.parent))
+    except OSError:
+        return Path(tempfile.mkdtemp(prefix=".clearance-partial-", dir=folder))
+
+
+@contextmanager
+def staged_outputs(folder: Path) -> Iterator[Path]:
+    """Write a command's files into a private folder; move them into ``folder`` when the block ends well.
+
+    The files move one by one (`os.replace`, on the same file system: nothing is copied), Markdown
+    reports last, replacing files of the same names; others in ``folder`` are left alone. When
+    the block raises, the private folder and everything in it are removed, so ``folder`` holds
+    no file of the failed command.
+
+    Args:
+        folder: the output folder (exists; the command holds its lock).
+
+    Yields:
+        The private folder to write into.
+    """
+    stage = _stage_folder(folder)
+    try:
+        yield stage
+        files = sorted((f for f in stage.rglob("*") if f.is_file()), key=lambda f: (f.suffix == ".md", str(f)))
+        for f in files:
+            dest = folder / f.relative_to(stage)
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            os.replace(f, dest)
+    finally:
+        shutil.rmtree(stage, ignore_errors=True)
+
+
+_WRITE_ERRNOS = {errno.ENOSPC, errno.EDQUOT, errno.EROFS, errno.EACCES, errno.EPERM, errno.EIO, errno.EFBIG}
+"""System errors that say a file could not be written (a full disk, a read-only or vanished folder)."""
+
+
+def write_fault(err: OSError) -> str:
+    """One line for an `OSError` met while a command wrote its files: which file, and why.
+
+    Args:
+        err: the error (its ``filename`` names the file, where the system gave it).
+
+    Returns:
+        ``cannot write <file> (<reason>)``, with a remedy for a full disk.
+    """
+    where = f" {err.filename}" if err.filename else ""
+    why = err.strerror or type(err).__name__
+    remedy = "; free some space, or give another folder" if err.errno in (errno.ENOSPC, errno.EDQUOT) else ""
+    verb = "write" if err.errno in _WRITE_ERRNOS else "use"
+    return f"cannot {verb}{where} ({why}){remedy}"
 
 
 def _remove_empty(created: list[Path]) -> None:

@@ -12,7 +12,8 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from clearance.cli.options import add_sweep_args, bounded, positive, rpm_option, si, sweep_options, sweep_out
-from clearance.cli.paths import check_folder, folder_lock
+from clearance.cli.parser import CommandParser
+from clearance.cli.paths import check_folder, folder_lock, staged_outputs
 from clearance.cli.sweep_common import (
     UsageError,
     catalogue_entry,
@@ -20,6 +21,7 @@ from clearance.cli.sweep_common import (
     interrupted,
     probe,
     report_failures,
+    stopped,
     usage_error,
 )
 
@@ -28,13 +30,13 @@ __all__ = ["main_rank", "rank_parser"]
 
 def rank_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance rank``."""
-    p = argparse.ArgumentParser(prog="clearance rank", description="Rank clearance joints by output deviation.")
+    p = CommandParser(prog="clearance rank", description="Rank clearance joints by output deviation.")
     p.add_argument(
         "--clearances-mm",
         type=positive(float, "--clearances-mm"),
         nargs="+",
         default=[0.1, 0.5],
-        help="clearances [mm]",
+        help="clearances [mm] (default 0.1 0.5)",
     )
     p.add_argument(
         "--rpm",
@@ -56,7 +58,8 @@ def rank_parser() -> argparse.ArgumentParser:
         metavar="MODEL.xml",
         default=None,
         help="rank the hinges of a MuJoCo model (a robot) by what radial play or backlash at each costs its end "
-        "effector, instead of a catalogue mechanism's joints (see clearance rank --model M --help)",
+        "effector, instead of a catalogue mechanism's joints (default: none, the catalogue's --mechanism; see "
+        "clearance rank --model M --help)",
     )
     add_sweep_args(p, "rank")
     return p
@@ -66,7 +69,8 @@ def main_rank(argv: Sequence[str] | None = None) -> int:
     """Run ``clearance rank``; writes ``ranking.md`` and ``criticality.png``; returns the exit code.
 
     Exit codes: 0 every point ran, 1 a point failed (the ranking, if any, uses the others),
-    2 a usage error, 130 interrupted (Ctrl-C; the finished points are kept).
+    2 a usage error, 3 stopped by --stop-after (rerun to resume), 130 interrupted (Ctrl-C; the
+    finished points are kept).
     """
     if argv is not None and any(a == "--model" or a.startswith("--model=") for a in argv):
         from clearance.cli.rank_model import main_rank_model
@@ -146,9 +150,15 @@ def _rank(args: argparse.Namespace, out: Path) -> int:
                 stop_after=args.stop_after,
                 max_workers=args.workers,
             )
+            if not ranking.complete:  # stopped by --stop-after: no ranking of a part
+                done = len(list((out / "points").glob("point_*.json")))
+                return stopped(
+                    args.stop_after, f"{done} points", out / "points", "ranking.md and criticality.png are written"
+                )
             table = ranking_markdown(ranking)
-            atomic_write_text(out / "ranking.md", "# Clearance-joint criticality\n\n" + table)
-            plot_criticality(ranking, path=out / "criticality.png")
+            with staged_outputs(out) as stage:  # both files, or neither
+                atomic_write_text(stage / "ranking.md", "# Clearance-joint criticality\n\n" + table)
+                plot_criticality(ranking, path=stage / "criticality.png")
     except NothingToRankError as err:
         return report_failures(len(err.failed), len(err.failed), err.failed[0][1] if err.failed else "", out)
     except SchedulerError as err:

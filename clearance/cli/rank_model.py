@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from clearance.cli.options import bounded, positive, si
+from clearance.cli.parser import CommandParser
 from clearance.cli.paths import check_folder, folder_lock
 from clearance.cli.sweep_common import UsageError, check_scheduler, interrupted, usage_error
 
@@ -51,12 +52,16 @@ MAX_DURATION_MS = 60_000.0
 """Longest run a ranking takes [ms]."""
 
 
+MIN_STEPS_PER_PERIOD = 10
+"""The fewest of the model's own time steps a period of the sizing sinusoid may span (--frequencies-hz's bound)."""
+
+
 def rank_model_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance rank --model``."""
     from clearance.retrofit import MAX_BACKLASH
 
     d = DEFAULTS
-    p = argparse.ArgumentParser(
+    p = CommandParser(
         prog="clearance rank", description="Rank a robot's hinges by what their play costs its end effector."
     )
     p.add_argument("--model", required=True, metavar="MODEL.xml", help="the MuJoCo model (MJCF)")
@@ -137,7 +142,9 @@ def rank_model_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--out", default=None, help="output folder (default clearance-rank-<model>); rerun to resume")
     p.add_argument("--scheduler", default=None, metavar="ADDRESS", help="Dask scheduler address (default: local)")
-    p.add_argument("--workers", type=positive(int, "--workers"), default=None, help="local worker processes")
+    p.add_argument(
+        "--workers", type=positive(int, "--workers"), default=None, help="local worker processes (default: CPU count)"
+    )
     p.add_argument("--no-progress", action="store_true", help="no progress bar")
     return p
 
@@ -209,6 +216,13 @@ def _plan(args: argparse.Namespace) -> _Plan:
         check_grid(args.amplitudes, args.frequencies_hz, duration, startup)
     except ValueError as err:
         raise ValueError(f"--amplitudes/--frequencies-hz/--duration-ms/--startup-ms: {err}") from None
+    top = 1.0 / (MIN_STEPS_PER_PERIOD * model.opt.timestep)
+    for f in args.frequencies_hz:
+        if f > top:
+            raise ValueError(
+                f"--frequencies-hz {f:g}: at most {top:g} Hz for {path}: the sinusoid's period must span at least "
+                f"{MIN_STEPS_PER_PERIOD} of the model's own time steps ({model.opt.timestep:g} s) to be followed"
+            )
     material = Material(args.youngs_modulus_gpa * UNITS["pressure"]["gpa"], 0.3)
     clearance = Clearance(
         si(args.clearance_mm, "mm"),

@@ -15,10 +15,17 @@ from clearance.cli.options import (
     positive,
     si,
 )
-from clearance.cli.outputs import check_output_paths, duration_from_args, duration_source, write_outputs
+from clearance.cli.outputs import (
+    check_output_paths,
+    duration_from_args,
+    duration_source,
+    write_outputs,
+    writing_outputs,
+)
 from clearance.cli.paths import folder_lock
 from clearance.model import Mechanism
 from clearance.results import SimulationResult
+from clearance.units import format_quantity
 
 __all__ = ["add_parser", "command"]
 
@@ -37,7 +44,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--duration-ms",
         type=positive(float, "--duration-ms"),
         default=None,
-        help="simulated time [ms] (overrides --revolutions)",
+        help="simulated time [ms] (overrides --revolutions; default: one revolution's time)",
     )
     f.add_argument(
         "--rtol",
@@ -49,7 +56,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--output-us", type=positive(float, "--output-us"), default=10.0, help="output interval [µs] (default 10)"
     )
     f.add_argument("--out", default="clearance-reference-out", help="output folder (default clearance-reference-out)")
-    f.add_argument("--rerun", default=None, metavar="PATH", help="also write a rerun recording (.rrd) to PATH")
+    f.add_argument(
+        "--rerun", default=None, metavar="PATH", help="also write a rerun recording (.rrd) to PATH (default: none)"
+    )
     f.add_argument("--no-progress", action="store_true", help="no progress bar")
     f.set_defaults(run_command=command)
 
@@ -85,7 +94,7 @@ def _reference(args: argparse.Namespace, mech: Mechanism, duration: float, inter
 
     print(
         f"{mech.name} (reference solver): clearance at {[j.name for j in mech.joints if j.has_play]}, "
-        f"{duration * 1e3:.3g} ms, rtol {args.rtol:g}"
+        f"{format_quantity(duration, 's')}, rtol {args.rtol:g}"
     )
     progress = not args.no_progress
     failed = None
@@ -97,16 +106,20 @@ def _reference(args: argparse.Namespace, mech: Mechanism, duration: float, inter
             print(f"error: {failed}", file=sys.stderr)
             return 2
         result = partial
-    print(f"  ideal twin (no clearance), {duration * 1e3:.3g} ms, for the deviations")
+    print(f"  ideal twin (no clearance), {format_quantity(duration, 's')}, for the deviations")
     try:
         ideal = run_reference(mech.ideal_twin(), duration, output_interval=interval, rtol=args.rtol, progress=progress)
     except ReferenceSolverError as err:
         print(f"error: the ideal twin (no clearance), needed for the deviations: {err}", file=sys.stderr)
         return 2
-    write_outputs(args, mech, result, ideal, out)
+    with writing_outputs(out, args.rerun) as (stage, recording):
+        stopped = None if failed is None else str(failed)
+        write_outputs(args, mech, result, ideal, stage, recording=recording, stopped=stopped)
+    rrd = None if not args.rerun else Path(args.rerun).resolve()
     for line in _slider_lines(result):
         print(line)
-    print(f"  wall time {result.metadata.get('wall_time_s', float('nan')):.3g} s; wrote {out}/")
+    wall = format_quantity(result.metadata.get("wall_time_s", float("nan")), "s")
+    print(f"  wall time {wall}; wrote {out}/" + ("" if rrd is None else f" and {rrd}"))
     if failed is not None:
         print(f"error: {failed}", file=sys.stderr)
         return 2

@@ -1,4 +1,4 @@
-"""``clearance retrofit``: radial clearance at hinges of any MuJoCo model (ring mode).
+"""``clearance retrofit``: radial play or gear backlash at hinges of any MuJoCo model.
 
     clearance retrofit MODEL.xml --joint NAME [--joint NAME ...] --out DIR
 
@@ -24,15 +24,18 @@ from __future__ import annotations
 
 import argparse
 import math
+import time
 from dataclasses import replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from clearance.cli.limits import check_clearance, check_steps
 from clearance.cli.options import bounded, positive, segments_option, si, timestep_option
-from clearance.cli.paths import check_folder, folder_lock
+from clearance.cli.outputs import calibration_lines
+from clearance.cli.paths import check_folder, folder_lock, staged_outputs
 from clearance.model import ContactLaw, Material
 from clearance.units import UNITS
+from clearance.units import format_quantity as q
 
 if TYPE_CHECKING:
     import mujoco
@@ -63,6 +66,17 @@ the hinge gear backlash of that half-width instead of radial play, with its stop
 BACKLASH_KEYS = ("backlash_arcmin", "mesh_stiffness", "restitution")
 """The keys a --joint with backlash takes."""
 
+DESCRIPTION = (
+    "Give hinges of any MuJoCo model radial play (each hinge gains two in-plane slides, its parent a ring "
+    "bearing and its child a journal; or, with --contact-mode exact, the compiled exact contact) or gear "
+    "backlash (--joint NAME:backlash_arcmin=B: a motor side that takes the hinge's actuators, the link turning "
+    "within +-B arcmin of it). Writes DIR/model.xml (stock MuJoCo opens a ring model), DIR/original.xml, "
+    "DIR/retrofit.md (every change, the sizing, the calibration, the time step, the speed cost) and "
+    "DIR/retrofit.json for 'clearance run --model DIR'. A hinge's own values follow its name, with units in the "
+    "keys: --joint elbow:clearance_mm=0.2,bearing_radius_mm=8,youngs_modulus_gpa=2.4."
+)
+"""The help's description: plain text, as a terminal shows it."""
+
 
 def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None:
     """Add ``retrofit`` to the subcommands ``sub`` (argparse's subparsers action)."""
@@ -70,8 +84,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
 
     p = sub.add_parser(
         "retrofit",
-        help="give hinges of any MuJoCo model radial clearance (a journal in a calibrated ring bearing)",
-        description=(__doc__ or "").split("\n\n")[0],
+        help="give hinges of any MuJoCo model radial play (a journal in a ring bearing) or gear backlash",
+        description=DESCRIPTION,
     )
     p.add_argument("model", metavar="MODEL.xml", help="the MuJoCo model (MJCF) to retrofit")
     p.add_argument(
@@ -145,14 +159,26 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
     num.add_argument(
         "--segments", type=segments_option(), default=None, help="ring segments per bearing (default: the ripple rule)"
     )
-    num.add_argument("--journal-geom", default="sphere", choices=("sphere", "capsule", "cylinder"))
-    num.add_argument("--segment-geom", default="sphere", choices=("sphere", "capsule", "box", "cylinder"))
+    num.add_argument(
+        "--journal-geom",
+        default="sphere",
+        choices=("sphere", "capsule", "cylinder"),
+        help="the journal's geom in its ring (ring contact modes only; default sphere: exact circle-in-circle "
+        "geometry in the plane)",
+    )
+    num.add_argument(
+        "--segment-geom",
+        default="sphere",
+        choices=("sphere", "capsule", "box", "cylinder"),
+        help="the geom of each ring segment (ring contact modes only; default sphere)",
+    )
     motion = p.add_argument_group("sizing motion (the unmodified model under a sinusoid on every actuator)")
     motion.add_argument(
         "--sine-amplitude",
-        type=bounded(float, "--sine-amplitude", 0.0),
+        type=positive(float, "--sine-amplitude"),
         default=0.5,
-        help="fraction of each actuator's control half-range (default 0.5)",
+        help="fraction of each actuator's control half-range, above 0 (no motion sizes nothing) and at most 1 for "
+        "an actuator with a ctrlrange (default 0.5)",
     )
     motion.add_argument(
         "--sine-frequency-hz", type=positive(float, "--sine-frequency-hz"), default=1.0, help="[Hz] (default 1)"
@@ -162,7 +188,8 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         default=None,
         metavar="CTRL.csv",
         help="size from the motion under this control file instead of the sinusoid (header time_s and one column "
-        "per actuator, its name or #k; linear in between, held beyond): a servo's set point, a recorded sequence",
+        "per actuator, its name or #k; linear in between, held beyond): a servo's set point, a recorded sequence "
+        "(default: none, the sinusoid)",
     )
     motion.add_argument(
         "--sizing-duration-s", type=positive(float, "--sizing-duration-s"), default=1.0, help="[s] (default 1)"
@@ -205,11 +232,15 @@ def _joint_values(args: argparse.Namespace, text: str) -> tuple[str, dict[str, f
         raise ValueError(f"--joint {text!r}: give the hinge's name first")
     if not sep:
         return name, values
+    given: set[str] = set()
     for item in rest.split(","):
         key, eq, value = item.partition("=")
         key = key.strip()
         if key not in JOINT_KEYS or not eq:
             raise ValueError(f"--joint {text!r}: '{item}' is not key=value with a key among {', '.join(JOINT_KEYS)}")
+        if key in given:
+            raise ValueError(f"--joint {text!r}: {key} is given twice; give each key once")
+        given.add(key)
         try:
             v = float(value)
         except ValueError:
@@ -346,9 +377,11 @@ def _backlash_command(args: argparse.Namespace, joints: dict[str, Backlash]) -> 
             line.append(f"--backlash-stop {args.backlash_stop}")
         if args.backlash_sensors != "load":
             line.append(f"--backlash-sensors {args.backlash_sensors}")
-        paths = write_backlash(
-            result, out, source_dir=Path(args.model).resolve().parent, source=str(args.model), command=" ".join(line)
-        )
+        with staged_outputs(out) as stage:  # every file, or none
+            source_dir = Path(args.model).resolve().parent
+            command = " ".join(line)
+            written = write_backlash(result, stage, source_dir=source_dir, source=str(args.model), command=command)
+        paths = {role: out / p.name for role, p in written.items()}
     for note in result.notes:
         print(note)
     print("wrote " + ", ".join(str(p) for p in paths.values()))
@@ -421,35 +454,43 @@ def command(args: argparse.Namespace) -> int:
     path = Path(args.model)
     spec = _read_model(path)
     check_steps(args.sizing_duration_s, spec.option.timestep, f"--sizing-duration-s {args.sizing_duration_s:g}")
-    if args.sizing_control is not None:
-        from clearance.retrofit.drive import actuator_labels, read_control_file
+    from clearance.cli.controls import check_sine_amplitude, read_controls
 
-        try:
-            labels = actuator_labels(spec.compile())
-        except ValueError as err:
-            raise ValueError(f"model file {path} does not compile: {err}") from None
-        options = replace(options, control=read_control_file(args.sizing_control, labels))
+    try:
+        compiled = spec.compile()
+    except ValueError as err:
+        raise ValueError(f"model file {path} does not compile: {err}") from None
+    if args.sizing_control is not None:
+        options = replace(options, control=read_controls(args.sizing_control, compiled, "--sizing-control"))
+    else:
+        check_sine_amplitude(args.sine_amplitude, compiled, "--sine-amplitude")
+    started = time.time()
     with folder_lock(out):
         try:
             result = retrofit(spec, plays, options)
         except ValueError as err:
             raise ValueError(f"{path}: {err}") from None
-        paths = write_retrofit(
-            result, out, source_dir=path.resolve().parent, source=str(path), command=_command_line(args)
-        )
+        with staged_outputs(out) as stage:  # beside out: the models' relative asset paths hold there too
+            written = write_retrofit(
+                result, stage, source_dir=path.resolve().parent, source=str(path), command=_command_line(args)
+            )
+        paths = {role: out / p.name for role, p in written.items()}
     for h in result.hinges.values():
         s = h.sizing
         print(
-            f"{h.name}: c = {h.play.clearance.radial_clearance * 1e3:g} mm, "
+            f"{h.name}: c = {q(h.play.clearance.radial_clearance, 'm')}, "
             f"{f'{s.segments} segments' if s.segments else 'no ring'}, effective mass "
-            f"{s.effective_mass:.3g} kg, peak load {s.peak_load:.3g} N, contact {h.contact.parameters.source}"
+            f"{s.effective_mass:.3g} kg, peak load {q(s.peak_load, 'N')}, contact {h.contact.parameters.source}"
         )
-    print(f"time step {result.timestep:g} s (the model's own {result.twin.opt.timestep:g} s)")
+        for line in calibration_lines({h.name: {"source": h.contact.parameters.source}}, started):
+            print(line.strip())
+    print(f"time step {q(result.timestep, 's')} (the model's own {q(result.twin.opt.timestep, 's')})")
     if result.speed is not None:
+        slower = result.speed.per_simulated_second
         print(
             f"speed cost: {result.speed.retrofitted.steps_per_second:,.0f} steps/s against "
             f"{result.speed.unmodified.steps_per_second:,.0f}; one simulated second takes "
-            f"{result.speed.per_simulated_second:.3g}x as long"
+            + (f"{slower:,.0f} times as long" if slower >= 100 else f"{slower:.3g} times as long")
         )
     for note in result.notes:
         print(f"note: {note}")

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 from clearance.cli.limits import check_steps
@@ -13,11 +14,19 @@ from clearance.cli.options import (
     options_from_args,
     positive,
 )
-from clearance.cli.outputs import check_output_paths, duration_from_args, duration_source, write_outputs
+from clearance.cli.outputs import (
+    calibration_lines,
+    check_output_paths,
+    duration_from_args,
+    duration_source,
+    write_outputs,
+    writing_outputs,
+)
 from clearance.cli.paths import folder_lock
 from clearance.cli.run_model import add_model_args, model_command, uses_model
 from clearance.model import Mechanism
 from clearance.options import ModelOptions
+from clearance.units import format_quantity
 
 __all__ = ["add_parser", "command"]
 
@@ -36,7 +45,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--duration-ms",
         type=positive(float, "--duration-ms"),
         default=None,
-        help="simulated time [ms] (overrides --revolutions)",
+        help="simulated time [ms] (overrides --revolutions; default: 3 revolutions' time)",
     )
     r.add_argument(
         "--out",
@@ -49,7 +58,7 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "--rerun",
         default=None,
         metavar="PATH",
-        help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH",
+        help="also write a rerun recording (.rrd) of the run and its ideal twin to PATH (default: none)",
     )
     add_model_args(r)
     r.set_defaults(run_command=command)
@@ -73,20 +82,27 @@ def command(args: argparse.Namespace) -> int:
         return _run(args, mech, options, duration, out)
 
 
+def _segments(segments: dict[str, int]) -> str:
+    """A ring's segment counts for the console: ``144 segments at rod_slider``."""
+    return ", ".join(f"{n} segments at {joint}" for joint, n in segments.items())
+
+
 def _run(args: argparse.Namespace, mech: Mechanism, options: ModelOptions, duration: float, out: Path) -> int:
     from clearance.results import atomic_write_text
     from clearance.run.preparation import prepare
     from clearance.run.simulation import SimulationError, simulate_prepared
 
+    started = time.time()
     prepared = prepare(mech, options)
     ideal_prepared = prepare(mech.ideal_twin(), options)
-    atomic_write_text(out / "model.xml", prepared.to_xml())
-    atomic_write_text(out / "ideal_model.xml", ideal_prepared.to_xml())
     print(
         f"{mech.name}: clearance at {[j.name for j in mech.clearance_joints]}, "
-        f"{duration * 1e3:.3g} ms at h = {options.timestep:g} s, {options.contact_mode.value} contact"
-        + ("" if prepared.built.exact_contact else f", segments {prepared.metadata['segments']}")
+        f"{format_quantity(duration, 's')} at h = {format_quantity(options.timestep, 's')}, "
+        f"{options.contact_mode.value} contact"
+        + ("" if prepared.built.exact_contact else ", " + _segments(prepared.metadata["segments"]))
     )
+    for line in calibration_lines(prepared.metadata.get("contact", {}), started):
+        print(line)
     progress = not args.no_progress
     failed = None
     try:
@@ -102,8 +118,14 @@ def _run(args: argparse.Namespace, mech: Mechanism, options: ModelOptions, durat
     except SimulationError as err:
         print(f"error: the ideal twin (no clearance), needed for the deviations: {err}", file=sys.stderr)
         return 2
-    write_outputs(args, mech, result, ideal, out)
-    print(f"  {result.metadata['steps_per_second']:.3g} steps/s; wrote {out}/")
+    with writing_outputs(out, args.rerun) as (stage, recording):
+        atomic_write_text(stage / "model.xml", prepared.to_xml())
+        atomic_write_text(stage / "ideal_model.xml", ideal_prepared.to_xml())
+        stopped = None if failed is None else str(failed)
+        write_outputs(args, mech, result, ideal, stage, recording=recording, stopped=stopped)
+    rate = float(f"{result.metadata['steps_per_second']:.3g}")
+    rrd = "" if not args.rerun else f" and {Path(args.rerun).resolve()}"
+    print(f"  {rate:,.0f} steps/s; wrote {out}/{rrd}")
     if failed is not None:
         print(f"error: {failed}", file=sys.stderr)
         return 2

@@ -26,6 +26,9 @@ from typing import TYPE_CHECKING
 
 from clearance.cli.limits import check_steps
 from clearance.cli.options import bounded, positive, si
+from clearance.cli.outputs import writing_outputs
+from clearance.result_units import result_units
+from clearance.units import format_quantity as q
 
 if TYPE_CHECKING:
     from clearance.retrofit.drive import Drive
@@ -36,6 +39,7 @@ __all__ = ["add_model_args", "uses_model", "model_command", "SCENARIO_DESTS"]
 SCENARIO_DESTS = {
     "mechanism": "--mechanism",
     "scenario": "--scenario",
+    "clearance_mm": "--clearance-mm",
     "clearance_at": "--clearance-at",
     "rpm": "--rpm",
     "timestep_us": "--timestep-us",
@@ -76,7 +80,8 @@ def add_model_args(r: argparse.ArgumentParser) -> None:
         "--sine-amplitude",
         type=bounded(float, "--sine-amplitude", 0.0),
         default=None,
-        help="sinusoid on every actuator: fraction of its control half-range (default 0.5)",
+        help="sinusoid on every actuator: fraction of its control half-range, at most 1 for an actuator with a "
+        "ctrlrange (default 0.5; 0: no motion)",
     )
     g.add_argument(
         "--sine-frequency-hz",
@@ -136,19 +141,34 @@ def _default_site(loaded: Retrofitted) -> list[str]:
 
 def model_command(args: argparse.Namespace) -> int:
     """Run ``clearance run --model DIR``; returns the exit status (2: refused or stopped by an error)."""
+    from clearance.cli.controls import check_sine_amplitude, read_controls
     from clearance.cli.outputs import check_output_paths
     from clearance.cli.paths import folder_lock
     from clearance.retrofit import SineControl
-    from clearance.retrofit.drive import actuator_labels, read_control_file
     from clearance.run.retrofitted import load_retrofitted
 
     out = check_output_paths(args)
-    loaded = load_retrofitted(args.model)
+    given = Path(args.model)
+    if given.is_file() and not (given.parent / "retrofit.json").is_file():
+        raise ValueError(
+            f"--model {given}: a model file without the retrofit.json that clearance retrofit writes beside its "
+            f"model; retrofit it first (clearance retrofit {given} --joint NAME --out DIR), then run --model DIR"
+        )
+    try:
+        loaded = load_retrofitted(given)
+    except ValueError as err:  # the message starts with the path it is about
+        raise ValueError(f"--model {err}" if str(err).startswith(str(given)) else f"--model {given}: {err}") from None
     drive: Drive
     if args.control is not None:
-        drive = read_control_file(args.control, actuator_labels(loaded.model))
+        drive = read_controls(args.control, loaded.model, "--control")
     else:
         amplitude = 0.5 if args.sine_amplitude is None else args.sine_amplitude
+        check_sine_amplitude(amplitude, loaded.model, "--sine-amplitude")
+        if amplitude == 0:
+            print(
+                "warning: --sine-amplitude 0: the actuators get no motion; the run shows the model held at rest",
+                file=sys.stderr,
+            )
         drive = SineControl(amplitude, 1.0 if args.sine_frequency_hz is None else args.sine_frequency_hz)
     sites = [args.site] if args.site else _default_site(loaded)
     loaded.check_sites(sites)
@@ -175,10 +195,10 @@ def _run(
     if m.backlash:
         arcmin = ", ".join(f"{b.name} +-{b.half_width * 10800 / math.pi:.4g}'" for b in m.backlash)
         play = f"{play}; " * bool(play) + f"backlash at {arcmin}"
-    kind = f", {m.contact_mode} ring" if m.hinges else ""
+    kind = "" if not m.hinges else ", exact contact" if m.contact_mode == "exact" else f", {m.contact_mode} ring"
     print(
-        f"{loaded.folder}: {play}, {duration * 1e3:.4g} ms at h = {m.timestep:g} s (the model's own "
-        f"{m.original_timestep:g} s){kind}"
+        f"{loaded.folder}: {play}, {q(duration, 's', digits=4)} at h = {q(m.timestep, 's')} (the model's own "
+        f"{q(m.original_timestep, 's')}){kind}"
     )
     failed = None
     try:
@@ -194,48 +214,53 @@ def _run(
     except SimulationError as err:
         print(f"error: the unmodified twin, needed for the deviations: {err}", file=sys.stderr)
         return 2
-    result.save(out / "result")
-    twin.save(out / "ideal")
+    for run in (result, twin):  # every array's and number's unit, in the files themselves
+        run.metadata["units"] = result_units(run.arrays())
+    stopped = None if failed is None else str(failed)
+    if stopped is not None:
+        result.metadata["stopped"] = stopped
     rows = summarise(result, None)
-    write_summary_csv(rows, out / "summary.csv")
     backlash = backlash_summaries(result)
-    if backlash:
-        write_backlash_csv(backlash, out / "backlash_summary.csv")
-    deviation = None
-    if sites and len(result.times) >= 3:
-        deviation = site_deviation(result, twin, sites[0])
-        write_site_deviation_csv(deviation, out / "site_deviation.csv")
+    deviation = site_deviation(result, twin, sites[0]) if sites and len(result.times) >= 3 else None
     # contacts longer than 5 % of the sinusoid's period (of the run, under a control file) are continuous
     period = 1.0 / drive.frequency if isinstance(drive, SineControl) else duration
-    stopped = None if failed is None else str(failed)
-    write_model_report(out, result, twin, rows, deviation, continuous_after=0.05 * period, stopped=stopped)
-    if args.rerun:
-        from clearance.analysis.recording.model_rerun import record_model_run
+    with writing_outputs(out, args.rerun) as (stage, recording):  # all of them, or none
+        result.save(stage / "result")
+        twin.save(stage / "ideal")
+        write_summary_csv(rows, stage / "summary.csv")
+        if backlash:
+            write_backlash_csv(backlash, stage / "backlash_summary.csv")
+        if deviation is not None:
+            write_site_deviation_csv(deviation, stage / "site_deviation.csv")
+        write_model_report(stage, result, twin, rows, deviation, continuous_after=0.05 * period, stopped=stopped)
+        if recording is not None:
+            from clearance.analysis.recording.model_rerun import record_model_run
 
-        rrd = record_model_run(result, twin, loaded.model, loaded.twin, args.rerun, deviation=deviation).resolve()
-        print(f"  rerun recording written to {rrd} (open it with: rerun {rrd})")
+            record_model_run(result, twin, loaded.model, loaded.twin, recording, deviation=deviation)
+    rrd = None if not args.rerun else Path(args.rerun).resolve()
     for r in rows:
         if not r.max_penetration > 0:
-            print(f"  {r.joint}: no contact (the journal stayed {-r.max_penetration * 1e6:.3g} µm from its ring)")
+            print(f"  {r.joint}: no contact (the journal stayed {q(-r.max_penetration, 'm')} from its ring)")
             continue
         print(
-            f"  {r.joint}: peak force {r.peak_force:.4g} N at {r.peak_force_time * 1e3:.3f} ms, p95 "
-            f"{r.p95_force:.4g} N, {r.impacts} impacts, max penetration {r.max_penetration * 1e6:.3g} µm"
+            f"  {r.joint}, whole run: peak force {q(r.peak_force, 'N', digits=4)} at {q(r.peak_force_time, 's')}, "
+            f"p95 {q(r.p95_force, 'N', digits=4)}, {r.impacts} impacts, max penetration {q(r.max_penetration, 'm')}"
         )
     for b in backlash:
         print(
             f"  {b.hinge}: backlash angle in [{b.min_angle * 10800 / math.pi:.4g}, {b.max_angle * 10800 / math.pi:.4g}]"
             f"' (band +-{b.half_width * 10800 / math.pi:.4g}'), {b.impacts} impacts at its ends ({b.impacts_upper} at "
-            f"+b, {b.impacts_lower} at -b), peak stop torque {b.peak_torque:.4g} N m at "
-            f"{b.peak_torque_time * 1e3:.3f} ms"
+            f"+b, {b.impacts_lower} at -b), peak stop torque {q(b.peak_torque, 'N m', digits=4)} at "
+            f"{q(b.peak_torque_time, 's')}"
         )
     if deviation is not None:
-        axes = ", ".join(f"{k.rsplit('/', 1)[1]} {s.rms_deviation * 1e3:.3g}" for k, s in deviation.axes.items())
+        axes = ", ".join(f"{k.rsplit('/', 1)[1]} {q(s.rms_deviation, 'm')}" for k, s in deviation.axes.items())
         print(
-            f"  {deviation.site}: deviation from the twin up to {deviation.max_distance * 1e3:.3g} mm; RMS [mm] {axes}"
-            + ("" if args.site else " (the end effector by default: --site to choose another point)")
+            f"  {deviation.site}: deviation from the twin up to {q(deviation.max_distance, 'm')} over the whole run; "
+            f"RMS {axes}" + ("" if args.site else " (the end effector by default: --site to choose another point)")
         )
-    print(f"  {result.metadata['steps_per_second']:.3g} steps/s; wrote {out}/")
+    rate = float(f"{result.metadata['steps_per_second']:.3g}")
+    print(f"  {rate:,.0f} steps/s; wrote {out}/" + ("" if rrd is None else f" and {rrd}"))
     if failed is not None:
         print(f"error: {failed}", file=sys.stderr)
         return 2

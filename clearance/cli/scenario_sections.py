@@ -16,7 +16,10 @@ from typing import Any
 
 from clearance.cli.sweep_common import UsageError
 
-__all__ = ["ScenarioSection", "split_section"]
+__all__ = ["DESIGN_SECTIONS", "ScenarioSection", "split_section"]
+
+DESIGN_SECTIONS = {"allocation": "clearance allocate", "optimise": "clearance optimise"}
+"""The design tools' sections a scenario file may hold beside its mechanism, and the command of each."""
 
 _HEADER = re.compile(r"^\s*\[\[?\s*([^\]]+?)\s*\]\]?\s*(#.*)?$")
 """A table or array-of-tables header line; group 1 is its dotted name."""
@@ -44,6 +47,9 @@ def _top_name(header: str) -> str:
 def split_section(path: str | Path, section: str) -> ScenarioSection:
     """Read ``path`` and split off its ``[section]`` (and ``[section.*]``) tables.
 
+    Every design tool's section (`DESIGN_SECTIONS`) is blanked in the scenario text, so one file
+    may carry the settings of several tools beside its mechanism.
+
     Args:
         path: the scenario file (``--scenario``).
         section: the design tool's section name, e.g. "allocation".
@@ -70,6 +76,6 @@ def split_section(path: str | Path, section: str) -> ScenarioSection:
     for line in text.splitlines():
         m = _HEADER.match(line)
         if m:
-            inside = _top_name(m.group(1)) == section
+            inside = _top_name(m.group(1)) in (section, *DESIGN_SECTIONS)
         lines.append("" if inside else line)
     return ScenarioSection("\n".join(lines) + "\n", doc, table)

@@ -23,7 +23,8 @@ from clearance.cli.options import (
     sweep_options,
     sweep_out,
 )
-from clearance.cli.paths import check_folder, folder_lock
+from clearance.cli.parser import CommandParser
+from clearance.cli.paths import check_folder, folder_lock, staged_outputs
 from clearance.cli.sweep_common import (
     UsageError,
     catalogue_entry,
@@ -32,6 +33,7 @@ from clearance.cli.sweep_common import (
     probe,
     quantities,
     report_failures,
+    stopped,
     usage_error,
 )
 
@@ -40,10 +42,13 @@ __all__ = ["main_sweep", "sweep_parser"]
 
 def sweep_parser() -> argparse.ArgumentParser:
     """Parser of ``clearance sweep``."""
-    p = argparse.ArgumentParser(
-        prog="clearance sweep", description="Bifurcation diagram over clearance or crank speed."
+    p = CommandParser(prog="clearance sweep", description="Bifurcation diagram over clearance or crank speed.")
+    p.add_argument(
+        "--parameter",
+        choices=["clearance", "speed"],
+        default="clearance",
+        help="swept parameter: the radial clearance of every clearance joint, or the drive speed (default clearance)",
     )
-    p.add_argument("--parameter", choices=["clearance", "speed"], default="clearance", help="swept parameter")
     p.add_argument(
         "--start",
         type=positive(float, "--start"),
@@ -191,8 +196,14 @@ def _sweep(args: argparse.Namespace, out: Path) -> int:
                 stop_after=args.stop_after,
                 max_workers=args.workers,
             )
+            if len(diagram.values) < args.points:  # stopped by --stop-after: no figure of a part
+                return stopped(
+                    args.stop_after, f"{len(diagram.values)} of {args.points} points", out / "points",
+                    "bifurcation.png is drawn",
+                )  # fmt: skip
             png = out / "bifurcation.png"
-            plot_bifurcation(diagram, path=png)
+            with staged_outputs(out) as stage:  # a whole figure or none
+                plot_bifurcation(diagram, path=stage / png.name)
     except SchedulerError as err:
         return usage_error(f"--scheduler {args.scheduler}: {err}")
     counts = {r: diagram.regimes.count(r) for r in dict.fromkeys(diagram.regimes)}
@@ -200,4 +211,4 @@ def _sweep(args: argparse.Namespace, out: Path) -> int:
     errors = [e for r, e in zip(diagram.regimes, diagram.errors) if r == "error"]
     if errors:
         return report_failures(len(errors), len(diagram.values), errors[0], out)
-    return 0 if len(diagram.values) == args.points else 3
+    return 0

@@ -17,24 +17,31 @@ from typing import TYPE_CHECKING, Any
 from clearance.builders.catalogue import CatalogueEntry
 from clearance.cli.limits import check_mechanism, check_steps
 from clearance.model import Mechanism
+from clearance.options import ModelOptions
 
 if TYPE_CHECKING:  # the analysis is imported by the commands that sweep, when they run
     from clearance.analysis.sweeps.sweep import MechanismFactory
 
 __all__ = [
     "INTERRUPTED",
+    "STOPPED",
     "UsageError",
     "catalogue_entry",
+    "check_prepares",
     "check_scheduler",
     "interrupted",
     "probe",
     "quantities",
     "report_failures",
+    "stopped",
     "usage_error",
 ]
 
 INTERRUPTED = 130
 """Exit status of a command stopped with Ctrl-C (128 + SIGINT, as shells report it)."""
+
+STOPPED = 3
+"""Exit status of a command stopped early by ``--stop-after`` (resumable: the same command goes on)."""
 
 _JOINT_PARTS = ("ex", "ey", "vx", "vy", "e", "force")
 """Parts of a clearance joint that `chaos.quantity_series` samples (``<joint>.<part>``)."""
@@ -69,6 +76,23 @@ def interrupted(out: Path) -> int:
     kept = len(list((out / "points").glob("point_*.json"))) if (out / "points").is_dir() else 0
     print(f"interrupted; {kept} points kept in {out}, rerun to resume", file=sys.stderr)
     return INTERRUPTED
+
+
+def stopped(limit: int, done: str, kept: Path, skipped: str) -> int:
+    """Say that ``--stop-after`` stopped the command, what is kept and what was not written; return 3.
+
+    Args:
+        limit: the ``--stop-after`` value.
+        done: what has run so far (``12 of 200 points``, ``3 runs``).
+        kept: where the finished work is kept.
+        skipped: the final outputs not written yet (they would show a part as the whole).
+    """
+    print(
+        f"stopped by --stop-after {limit}: {done} have run, kept in {kept}; {skipped} when every one has run: "
+        "run the same command again to resume",
+        file=sys.stderr,
+    )
+    return STOPPED
 
 
 def check_scheduler(address: str | None) -> None:
@@ -130,6 +154,31 @@ def probe(
     except ValueError as err:
         raise UsageError(str(err)) from None
     return mech
+
+
+def check_prepares(mech: Mechanism, options: ModelOptions, where: str, timestep: str) -> None:
+    """Prepare one run's model up front, so a setting every run shares is refused once, not in each run.
+
+    A time step the contact cannot take (`clearance.run.preparation.TimeStepError`) would fail
+    every run of a batch alike; here it is one refusal naming the option.
+
+    Args:
+        mech: a mechanism of the batch (its stiffest contact: the smallest clearances).
+        options: the runs' `ModelOptions`.
+        where: the options that set the mechanism, for other refusals.
+        timestep: the option that set the time step (``--timestep-us 1000``, or ``the default time step``).
+
+    Raises:
+        UsageError: the model cannot be prepared with these options.
+    """
+    from clearance.run.preparation import TimeStepError, prepare
+
+    try:
+        prepare(mech, options)
+    except TimeStepError as err:
+        raise UsageError(f"{timestep}: {err}") from None
+    except ValueError as err:
+        raise UsageError(f"{where}: {err}") from None
 
 
 def report_failures(failed: int, total: int, first: str, out: Path) -> int:

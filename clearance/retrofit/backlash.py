@@ -36,6 +36,7 @@ from dataclasses import dataclass, field
 import mujoco
 import numpy as np
 
+from clearance.checks import of_type
 from clearance.contact_calibration.torsional_stop import OMEGA_H
 from clearance.contact_plugin import require
 from clearance.contact_plugin.backlash_stop import add_backlash_stop
@@ -152,8 +153,7 @@ def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backl
     check_not_retrofitted(spec, twin)
     actuated: dict[str, list[int]] = {}
     for name, play in joints.items():
-        if not isinstance(play, Backlash):
-            raise RetrofitError(f"the backlash of hinge '{name}' must be a Backlash (got {play!r})")
+        of_type(f"joints[{name!r}]", play, Backlash, f"a Backlash (the backlash of hinge '{name}')")
         j = mujoco.mj_name2id(twin, mujoco.mjtObj.mjOBJ_JOINT, name) if isinstance(name, str) and name else -1
         if j < 0:
             raise RetrofitError(f"hinge '{name}': no joint of that name in {where}")
@@ -237,10 +237,14 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
         The edited model, its twin and what was added.
 
     Raises:
+        TypeError: ``spec``, ``joints`` or a backlash of the wrong type, naming it
+            (`clearance.checks.WrongTypeError`, also a ValueError).
         RetrofitError: before any work, for a joint that does not exist, is not a hinge, shares
             its body with another joint, has no actuator with ``joint=`` on it, or is driven
             through a tendon; a model that does not compile.
     """
+    of_type("spec", spec, mujoco.MjSpec, "a mujoco.MjSpec (read a model file with mujoco.MjSpec.from_file(path))")
+    of_type("joints", joints, Mapping, "a mapping hinge name -> Backlash (e.g. {'elbow': Backlash.from_arcmin(5)})")
     twin_spec = spec.copy()
     twin = compile_model(twin_spec)
     actuated = _check(twin, twin_spec, joints)

@@ -11,6 +11,7 @@ before backlash existed have no ``backlash`` field and read as none.
 from __future__ import annotations
 
 import json
+import math
 import os
 from dataclasses import asdict, dataclass
 from pathlib import Path
@@ -106,6 +107,12 @@ class RetrofitManifest:
     qvel_map: tuple[int, ...]
     backlash: tuple[BacklashRecord, ...] = ()
 
+    def __post_init__(self) -> None:
+        for name in ("timestep", "original_timestep"):
+            v = getattr(self, name)
+            if not (math.isfinite(v) and v > 0):
+                raise RetrofitError(f"{name} must be a finite time step > 0 [s] (got {v!r})")
+
     def to_json(self) -> str:
         """The file's text."""
         body: dict[str, Any] = {"format": FORMAT, **asdict(self)}
@@ -132,8 +139,10 @@ class RetrofitManifest:
                     BacklashRecord(**{**b, "actuators": tuple(b["actuators"])}) for b in raw.get("backlash", [])
                 ),
             )
-        except RetrofitError:
-            raise
+        except RetrofitError as err:
+            if str(err).startswith(where):
+                raise
+            raise RetrofitError(f"{where}: {err}; write it again with clearance retrofit") from None
         except (ValueError, KeyError, TypeError, AttributeError) as err:
             raise RetrofitError(
                 f"{where} is not a retrofit record ({type(err).__name__}: {err}); "

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 
 import mujoco
 
+from clearance.checks import of_type
 from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.spec import ring_geometry
 from clearance.model import Joint, JointType
@@ -138,11 +139,11 @@ class Retrofit:
 
 
 def _check_plays(joints: Mapping[str, RadialPlay]) -> None:
+    of_type("joints", joints, Mapping, "a mapping hinge name -> RadialPlay (e.g. {'elbow': RadialPlay()})")
     for name, play in joints.items():
         if not isinstance(name, str) or not name:
             raise RetrofitError(f"hinge names must be non-empty strings (got {name!r})")
-        if not isinstance(play, RadialPlay):
-            raise RetrofitError(f"the play of hinge '{name}' must be a RadialPlay (got {play!r})")
+        of_type(f"joints[{name!r}]", play, RadialPlay, f"a RadialPlay (the play of hinge '{name}')")
 
 
 def _spec_bodies(spec: mujoco.MjSpec) -> dict[int, mujoco.MjsBody]:
@@ -188,10 +189,14 @@ def retrofit(
         The retrofitted model, its twin and what was measured and added.
 
     Raises:
+        TypeError: ``spec``, ``joints`` or a play of the wrong type, naming it
+            (`clearance.checks.WrongTypeError`, also a ValueError).
         RetrofitError: a bad request or model, before any work (see `select_hinges`); a
             time step too large for a bearing.
         CalibrationStabilityError: a fitted contact unstable at the time step.
     """
+    of_type("spec", spec, mujoco.MjSpec, "a mujoco.MjSpec (read a model file with mujoco.MjSpec.from_file(path))")
+    of_type("options", options, (RetrofitOptions, type(None)), "a RetrofitOptions or None")
     options = options or RetrofitOptions()
     exact = options.contact_mode is ContactMode.EXACT
     clock = Clock()

@@ -395,8 +395,8 @@ def _finish(
         "links": [],
         "steps": steps,
         "output_every_steps": every,
-        "wall_time_s": wall,
-        "steps_per_second": steps / wall if wall > 0 else None,
+        "wall_time_s": float(f"{wall:.4g}"),  # 4 significant digits, as simulate's
+        "steps_per_second": float(f"{steps / wall:.4g}") if wall > 0 else None,
         "mujoco_version": mujoco.__version__,
         "package_version": __version__,
     }

@@ -16,10 +16,11 @@ import mujoco
 import numpy as np
 from mujoco import rollout
 
+from clearance.checks import finite
 from clearance.model import DriveKind, Mechanism
 from clearance.options import ContactParameters, ModelOptions
 from clearance.results import SimulationResult
-from clearance.run.preparation import PreparedModel, prepare
+from clearance.run.preparation import PreparedModel, check_run_arguments, prepare
 from clearance.run.readout import read_sensors
 from clearance.version import __version__
 
@@ -111,15 +112,18 @@ def simulate(
         drive angle / speed / torque, link poses, closure violation, metadata).
 
     Raises:
+        TypeError: an argument of the wrong type (a name for the mechanism, a dict for the
+            options), naming it (`clearance.checks.WrongTypeError`, also a ValueError).
         ValueError: bad arguments (before any work).
         AssemblyError: the mechanism cannot be assembled at t = 0.
         TimeStepError: the time step is too large for the contact stiffness.
         SimulationError: the run diverged (partial result attached).
     """
+    check_run_arguments(mechanism, options)
     options = options or ModelOptions()
     if duration is None:
         duration = default_duration(mechanism)
-    if not (isinstance(duration, (int, float)) and np.isfinite(duration) and duration > 0):
+    if not finite("duration", duration) > 0:
         raise ValueError(f"duration must be a positive number of seconds (got {duration!r})")
     if output_interval is not None and not (np.isfinite(output_interval) and output_interval > 0):
         raise ValueError(f"output_interval must be > 0 s (got {output_interval!r})")
