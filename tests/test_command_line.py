@@ -99,8 +99,8 @@ def test_every_option_states_its_default_and_no_help_shows_markup():
         for a in p._actions:
             if not a.option_strings or a.help == argparse.SUPPRESS or a.required:
                 continue
-            if isinstance(a, (argparse._StoreTrueAction, argparse._HelpAction, argparse._VersionAction)):
-                continue  # a flag's default is off
+            if a.nargs == 0:
+                continue  # a flag (--no-progress, --help, --version): its default is off
             if isinstance(a, argparse._AppendAction) and "repeat" in (a.help or ""):
                 continue  # given once per value; none by default
             if "default" not in (a.help or "") and "required" not in (a.help or ""):

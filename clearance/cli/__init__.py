@@ -74,14 +74,14 @@ _SUBPARSERS = (
 
 def build_parser() -> argparse.ArgumentParser:
     """The argument parser of the `clearance` command."""
-    from clearance.cli.parser import CommandParser, version_text
+    from clearance.cli.parser import CommandParser, VersionAction
 
     p = CommandParser(
         prog="clearance",
         description="Mechanisms with joint clearance in MuJoCo: simulate, sweep, rank, size and retrofit. "
         "Each command's options: clearance COMMAND --help.",
     )
-    p.add_argument("--version", action="version", version=version_text())
+    p.add_argument("--version", action=VersionAction)
     sub = p.add_subparsers(dest="command", required=True)
     for name, (_, _, text) in _OWN_PARSER.items():
         sub.add_parser(name, help=f"{text} (see 'clearance {name} --help')", add_help=False)

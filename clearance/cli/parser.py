@@ -14,7 +14,7 @@ from typing import NoReturn
 
 from clearance.cli.messages import USAGE_ERROR, one_line
 
-__all__ = ["CommandParser", "version_text"]
+__all__ = ["CommandParser", "VersionAction", "version_text"]
 
 
 class CommandParser(argparse.ArgumentParser):
@@ -32,6 +32,23 @@ class CommandParser(argparse.ArgumentParser):
         """Exit with ``status`` after writing ``message`` (if any) to stderr, flushed first."""
         sys.stdout.flush()
         super().exit(status, message)
+
+
+class VersionAction(argparse.Action):
+    """``--version``: print `version_text` and exit 0; the versions are looked up only when asked for."""
+
+    def __init__(self, option_strings: list[str], dest: str = argparse.SUPPRESS, **kwargs: object) -> None:
+        super().__init__(option_strings, dest, nargs=0, default=argparse.SUPPRESS, help="print the versions and exit")
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: object,
+        option_string: str | None = None,
+    ) -> None:
+        print(version_text())
+        parser.exit()
 
 
 def version_text() -> str:
