@@ -98,8 +98,11 @@ def run_folder(work: Path, page: Page, revolutions: float) -> Path:
     return work / page.name / f"{revolutions:g}rev"
 
 
-def make_run(page: Page, revolutions: float, folder: Path, *, redraw: bool, max_rows: int) -> str:
-    """Simulate (or load, with ``redraw``) one column's run and write its report; returns the column's note."""
+def make_run(page: Page, revolutions: float, folder: Path, *, redraw: bool, max_rows: int, commit: str) -> str:
+    """Simulate (or load, with ``redraw``) one column's run and write its report; returns the column's note.
+
+    A simulated run's folder records the commit it was simulated at (``simulated_at.txt``).
+    """
     from clearance.analysis.figures.report import write_report
     from clearance.analysis.metrics.reactions import summarise_reactions
     from clearance.builders import CATALOGUE
@@ -124,6 +127,7 @@ def make_run(page: Page, revolutions: float, folder: Path, *, redraw: bool, max_
         ideal = simulate_prepared(prepare(mech.ideal_twin(), options), duration=duration, output_interval=interval)
         result.save(folder / "result")
         ideal.save(folder / "ideal")
+        (folder / "simulated_at.txt").write_text(f"{commit} {datetime.datetime.now().isoformat(timespec='minutes')}\n")
     for old in folder.glob("*.png"):
         old.unlink()
     skip = mech.drive_period or 0.0
@@ -237,7 +241,7 @@ def main(argv: list[str] | None = None) -> int:
         columns = []
         for rev in page.revolutions:
             folder = run_folder(work, page, rev)
-            note = make_run(page, rev, folder, redraw=args.redraw, max_rows=args.max_rows)
+            note = make_run(page, rev, folder, redraw=args.redraw, max_rows=args.max_rows, commit=commit)
             columns.append((page.command(rev), note, folder))
         compose(page, columns, out / f"{page.name}.png", commit)
         done.append(page)
@@ -251,8 +255,17 @@ def main(argv: list[str] | None = None) -> int:
         "",
     ]
     index += [f"- [{p.name}]({p.name}.png): " + "; ".join(f"`{p.command(r)}`" for r in p.revolutions) for p in done]
+    stamps = sorted({_stamp(run_folder(work, p, r)) for p in done for r in p.revolutions})
+    if args.redraw:
+        index += ["", f"Figures redrawn from the runs kept in the work folder, simulated at: {'; '.join(stamps)}."]
     (out / "contact_sheet.md").write_text("\n".join(index) + "\n", encoding="utf-8")
     return 0
+
+
+def _stamp(folder: Path) -> str:
+    """The commit and time a kept run was simulated at ("unknown" for a run kept without them)."""
+    f = folder / "simulated_at.txt"
+    return f.read_text().strip() if f.exists() else "unknown"
 
 
 def _cpus() -> int:
