@@ -29,10 +29,13 @@ from clearance.analysis.figures.report_sections import (
     poincare_section,
     section_points,
 )
-from clearance.analysis.metrics.lag import OutputLag, joint_lag
-from clearance.analysis.metrics.response import window_peaks
-from clearance.analysis.metrics.statistics import DeviationStatistics, deviation_statistics, drive_period
-from clearance.results import ENERGY_TERMS, SimulationResult, atomic_write_text
+from clearance.analysis.figures.report_text import deviation_rows, q, response_table
+from clearance.analysis.figures.report_text import energy_section as energy_section
+from clearance.analysis.figures.report_text import lag_lines as lag_lines
+from clearance.analysis.figures.report_text import startup_lines as startup_lines
+from clearance.analysis.metrics.lag import joint_lag
+from clearance.analysis.metrics.statistics import deviation_statistics, drive_period
+from clearance.results import SimulationResult, atomic_write_text
 from clearance.units import format_quantity
 
 if TYPE_CHECKING:  # types only: the sweeps' modules load only where a diagram or ranking is drawn
@@ -42,6 +45,7 @@ if TYPE_CHECKING:  # types only: the sweeps' modules load only where a diagram o
 
 
 __all__ = ["write_report", "joint_sections", "energy_section", "lag_lines", "reactions_section", "startup_lines"]
+# energy_section, lag_lines and startup_lines live in report_text; re-exported here where users found them
 
 
 def joint_sections(result: SimulationResult, *, skip: float | None = None) -> dict[str, np.ndarray]:
@@ -58,105 +62,6 @@ def joint_sections(result: SimulationResult, *, skip: float | None = None) -> di
     period = drive_period(result)
     skip = period if skip is None else skip
     return {j: section_points(result, [f"{j}.ex", f"{j}.ey"], period, skip)[1] for j in result.joints}
-
-
-def _g(v: float) -> str:
-    return "n/a" if not np.isfinite(v) else f"{v:.4g}"
-
-
-def startup_lines(window: Window) -> list[str]:
-    """The report's paragraph naming the start-up window and how it is defined.
-
-    Args:
-        window: the run's start-up window.
-
-    Returns:
-        Markdown lines.
-    """
-    if window.startup <= 0:
-        return [
-            "**No start-up window**: the mechanism has no prescribed drive period; every number below is of "
-            "the whole run.",
-            "",
-        ]
-    lines = [
-        f"**Start-up window**: {window.span(window.start, window.split)}, the first period of the slowest "
-        "prescribed drive. The journal is released from the bearing centre and makes its first, largest "
-        "impacts in it. Start-up values are taken within it; steady-state values (peaks and peak ratios, "
-        "lag, deviation statistics, contact statistics, Poincaré sections) after it.",
-        "",
-    ]
-    if not window.has_steady_state:
-        lines += [
-            f"**No steady state**: the run ({window.span(window.start, window.end)}) is no longer than its "
-            "start-up window; the values below are of the start-up alone. Run at least two drive periods "
-            "for steady-state numbers.",
-            "",
-        ]
-    return lines
-
-
-def _si_unit(key: str, output: str) -> str:
-    """The SI unit of an output's position, velocity or acceleration series."""
-    base = "rad" if "angle" in output else "m"
-    return base + ("/s²" if key.endswith("_acc") else "/s" if key.endswith("_vel") else "")
-
-
-def _q(v: float, unit: str) -> str:
-    return format_quantity(v, unit, digits=4)
-
-
-def _response_table(result: SimulationResult, ideal: SimulationResult, keys: list[str], window: Window) -> list[str]:
-    lines = [
-        "| quantity | window | min | at | max | at | ideal min | ideal max | peak ratio |",
-        "|---|---|---:|---:|---:|---:|---:|---:|---:|",
-    ]
-    if window.startup > 0:
-        parts = [("start-up", window.start, window.split), ("steady state", window.split, np.inf)]
-    else:
-        parts = [("whole run", window.start, np.inf)]
-    for key in keys:
-        for name, a, b in parts:
-            p = window_peaks(result, ideal, key, start=a, end=b)
-            if p is None:
-                lines.append(f"| {key} | {name} | n/a | | n/a | | n/a | n/a | n/a |")
-                continue
-            bold = "**" if name == "steady state" else ""
-            u = _si_unit(key, keys[0])
-            lines.append(
-                f"| {key} | {name} | {_q(p.min_value, u)} | {_q(p.min_time, 's')} | {_q(p.max_value, u)} | "
-                f"{_q(p.max_time, 's')} | {_q(p.ideal_min, u)} | {_q(p.ideal_max, u)} | "
-                f"{bold}{p.peak_ratio:.3g}{bold} |"
-            )
-    return lines
-
-
-def lag_lines(lag: OutputLag) -> list[str]:
-    """The report's paragraph on the output's lag behind the ideal output (`metrics.lag.joint_lag`).
-
-    Args:
-        lag: the estimate.
-
-    Returns:
-        Markdown lines.
-    """
-    head = (
-        f"**Lag** of {lag.output} behind the ideal output: one estimate from displacement, velocity and "
-        "acceleration together (least squares, each signal weighted by the inverse of its own misfit; "
-        "`clearance.analysis.metrics.lag`)"
-    )
-    if not np.isfinite(lag.lag):
-        return [f"{head}: not estimated: {lag.note}.", ""]
-    unc = f" ± {lag.uncertainty * 1e3:.2g} ms (standard error over the periods)" if np.isfinite(lag.uncertainty) else ""
-    per = ", ".join(f"{k} {v * 1e3:.3g} ms" for k, v in lag.per_signal.items())
-    verdict = "Resolved." if lag.resolved else f"**Not resolved**: {lag.note}."
-    return [
-        f"{head}, over the steady state's {lag.periods} whole drive period{'s' if lag.periods != 1 else ''} "
-        f"({_q(lag.window[0], 's')} to {_q(lag.window[1], 's')}), searched within ±{_q(lag.bound, 's')} "
-        f"(an eighth of the period) on a {lag.resolution * 1e3:.2g} ms grid: **{lag.lag * 1e3:.3g} ms**{unc}; "
-        f"positive means later than the ideal. Each signal alone: {per}. {verdict}",
-        "",
-    ]
 
 
 def reactions_section(
@@ -189,45 +94,6 @@ def reactions_section(
     return reaction_section(result, ideal, startup=window.startup, figure="joint_reactions.png", rows=rows)
 
 
-def energy_section(result: SimulationResult) -> list[str]:
-    """Markdown lines of the report's "Energy balance" section.
-
-    Args:
-        result: a run; its energy series (`SimulationResult.energy`) may be empty.
-
-    Returns:
-        The section's lines: each term's change over the run [J], the residual at the end and
-        its largest magnitude against the largest energy exchanged, or a line saying why there
-        is no balance.
-    """
-    lines = ["## Energy balance", ""]
-    balance = result.energy_balance()
-    if balance is None:
-        return lines + ["The run carries no energy series (its model had no energy meter).", ""]
-    lines += ["| term | change over the run [J] |", "|---|---:|"]
-    lines += [f"| {k} | {_g(v)} |" for k, v in balance["change_J"].items() if k in ENERGY_TERMS]
-    if balance["residual_J"] is None:
-        return lines + [
-            "",
-            f"No residual: the solver does not record {', '.join(balance['missing'])}.",
-            "",
-        ]
-    rel = balance["residual_relative"]
-    lines += [
-        f"| **residual** | {_g(balance['residual_J'])} |",
-        "",
-        f"Largest |residual| over the run: {_g(balance['residual_max_abs_J'])} J, "
-        f"{'n/a' if rel is None else f'{rel:.2%}'} of the largest energy exchanged ({_g(balance['scale_J'])} J, "
-        "the largest range of any term). Residual = Δkinetic + Δgravity_potential + Δcontact_potential − the works "
-        "done on the mechanism (drive, equality, contact rows, other rows, dampers) + dissipated_work; it is "
-        "the integrator's energy error, first order in the time step. kinetic includes the speed drives' "
-        "armature. A ring bearing's stored energy is in contact_work (its contact_potential is 0); "
-        "compiled_contact_work is a check (−Δcontact_potential − dissipated_work), not a term.",
-        "",
-    ]
-    return lines
-
-
 def _deviation_lines(
     result: SimulationResult, ideal: SimulationResult, output: str, window: Window, out: Path
 ) -> list[str]:
@@ -240,52 +106,19 @@ def _deviation_lines(
     draw(plot_deviation, result, ideal, output, st, path=out / "deviation.png")
     steady = window.has_steady_state and window.startup > 0
     what = "the steady state (the start-up window skipped)" if steady else "the whole run (no steady state)"
-    span = f"{'steady state' if steady else 'whole run'}, {_q(st.window_start, 's')}–{_q(st.window_end, 's')}"
+    span = f"{'steady state' if steady else 'whole run'}, {q(st.window_start, 's')}–{q(st.window_end, 's')}"
     lines += [f"| statistic of d = {output} − ideal ({span}) | value |", "|---|---:|"]
     unit = "rad" if "angle" in output else "m"  # as the response figure tells an angle from a position
-    lines += [f"| {label} | {text} |" for label, text in _deviation_rows(st, unit)]
+    lines += [f"| {label} | {text} |" for label, text in deviation_rows(st, unit)]
     lines += [
         "",
-        f"Window from t = {_q(st.window_start, 's')}: {what}. Samples are autocorrelated: compare p-values "
+        f"Window from t = {q(st.window_start, 's')}: {what}. Samples are autocorrelated: compare p-values "
         "between runs, not as absolute levels.",
         "",
         "![deviation](deviation.png)",
         "",
     ]
     return lines
-
-
-_DEVIATION_LABELS = {
-    "n": ("samples", None),
-    "window_start": ("window start", "s"),
-    "window_end": ("window end", "s"),
-    "mean_deviation": ("mean deviation (mean of the absolute d)", "out"),
-    "mean_signed_deviation": ("mean signed deviation (mean of d)", "out"),
-    "rms_deviation": ("RMS deviation", "out"),
-    "max_deviation": ("largest absolute deviation", "out"),
-    "band90": ("90 % tolerance band (90th percentile of the absolute d)", "out"),
-    "band90_low": ("5th percentile of d", "out"),
-    "band90_high": ("95th percentile of d", "out"),
-    "t_statistic": ("paired t statistic", None),
-    "t_pvalue": ("paired t-test p-value", None),
-    "f_statistic": ("variance ratio F = var(y) / var(ideal)", None),
-    "f_pvalue": ("F-test p-value", None),
-    "ks_statistic": ("Kolmogorov–Smirnov distance", None),
-    "ks_pvalue": ("Kolmogorov–Smirnov p-value", None),
-}
-"""Each deviation statistic's label in the report, and its unit ("out": the output's own)."""
-
-
-def _deviation_rows(st: DeviationStatistics, unit: str) -> list[tuple[str, str]]:
-    """(label, value with its unit) of each deviation statistic, in `_DEVIATION_LABELS`' order."""
-    rows = []
-    for key, value in st.as_dict().items():
-        label, kind = _DEVIATION_LABELS.get(key, (key, None))
-        if kind is None:
-            rows.append((label, _g(value) if isinstance(value, float) else str(value)))
-        else:
-            rows.append((label, _q(value, unit if kind == "out" else kind)))
-    return rows
 
 
 def write_report(
@@ -411,7 +244,7 @@ def _report_lines(
     lines += ["## Response against the ideal mechanism", ""]
     lines += ["![response](response_vs_ideal.png)", ""]
     keys = [k for k in (output, f"{output}_vel", f"{output}_acc") if k in result.outputs]
-    lines += _response_table(result, ideal, keys, window)
+    lines += response_table(result, ideal, keys, window)
     lines += [
         "",
         "Each value in the unit its size calls for (mm, m/s, km/s², ...); peak ratio = max |y| / max |y_ideal| "
