@@ -169,7 +169,7 @@ def test_bad_hinges_are_refused(joints, expected):
 
 def test_slide_is_refused():
     xml = FLYWHEEL.replace('name="idle" type="hinge"', 'name="idle" type="slide"')
-    with pytest.raises(RetrofitError, match="needs a hinge"):
+    with pytest.raises(RetrofitError, match="is a slide joint: only a hinge can be given backlash"):
         add_backlash(mujoco.MjSpec.from_string(xml), {"idle": Backlash(B)})
 
 

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 from clearance.contact_calibration.fit import GOALS
 from clearance.mjcf.bearing import SEGMENT_CANDIDATES, RingGeometry, band_ripple
 from clearance.retrofit.contact import PlayContact
-from clearance.retrofit.play import RetrofitError
+from clearance.retrofit.play import Refusal, RetrofitError
 from clearance.retrofit.sizing import PlaySizing
 
 __all__ = ["ACCEPT_HINT", "InaccurateRetrofitError", "Miss", "fit_miss", "refuse_or_warn", "ripple_miss"]
@@ -126,6 +126,8 @@ def refuse_or_warn(misses: list[Miss], accept: bool) -> list[str]:
     if not accept:
         raise InaccurateRetrofitError(
             f"{len(misses)} ring{'s' * (len(misses) > 1)} would miss {'their' if len(misses) > 1 else 'its'} stated "
-            f"accuracy: {' | '.join(lines)}. {ACCEPT_HINT}"
+            f"accuracy: {' | '.join(lines)}. {ACCEPT_HINT}",
+            reason=Refusal.INACCURATE,
+            hinge=misses[0].hinge if len(misses) == 1 else None,
         )
     return [f"accuracy not met, kept with --accept-inaccurate: {line}" for line in lines]

@@ -41,12 +41,14 @@ from clearance.contact_calibration.torsional_stop import OMEGA_H
 from clearance.contact_plugin import require
 from clearance.contact_plugin.backlash_stop import add_backlash_stop
 from clearance.retrofit.backlash_stop import Band, BandStop, calibrate_stops, stop_note
+from clearance.retrofit.contact_softness import keep_contact_softness
 from clearance.retrofit.conventions import check_conventions
 from clearance.retrofit.coordinates import extend_paired_keyframes, joint_index_map
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.masses import FROZEN_NOTE, check_masses, freeze_inertials
-from clearance.retrofit.play import PREFIX, Backlash, RetrofitError
-from clearance.retrofit.selection import check_not_retrofitted, compile_model, model_label
+from clearance.retrofit.play import PREFIX, Backlash, Refusal, RetrofitError
+from clearance.retrofit.selection import check_not_retrofitted, compile_model, joint_kind, model_label
+from clearance.retrofit.softness import keep_constraint_softness, softness_note
 
 __all__ = [
     "MOTOR_ARMATURE_FRACTION",
@@ -158,11 +160,17 @@ def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backl
         if j < 0:
             raise RetrofitError(f"hinge '{name}': no joint of that name in {where}")
         if int(twin.jnt_type[j]) != int(_HINGE):
-            raise RetrofitError(f"hinge '{name}': backlash needs a hinge, got a joint of type {twin.jnt_type[j]}")
+            raise RetrofitError(
+                f"joint '{name}' is {joint_kind(twin, j)}: only a hinge can be given backlash",
+                reason=Refusal.NOT_A_HINGE,
+                hinge=name,
+            )
         body = int(twin.jnt_bodyid[j])
         if twin.body_jntnum[body] != 1:
             raise RetrofitError(
-                f"hinge '{name}': its body has {twin.body_jntnum[body]} joints; backlash needs it alone"
+                f"hinge '{name}': its body has {twin.body_jntnum[body]} joints; backlash needs it alone",
+                reason=Refusal.SHARED_BODY,
+                hinge=name,
             )
         if play.stop == "exact":
             for obj in (mujoco.mjtObj.mjOBJ_PLUGIN, mujoco.mjtObj.mjOBJ_SENSOR):
@@ -189,12 +197,16 @@ def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backl
             ):
                 raise RetrofitError(
                     f"hinge '{name}': actuator '{_actuator_label(twin, k)}' drives it through a tendon; backlash moves "
-                    "only actuators with joint= to the motor side"
+                    "only actuators with joint= to the motor side",
+                    reason=Refusal.TENDON_DRIVEN,
+                    hinge=name,
                 )
         if not on_joint:
             raise RetrofitError(
                 f"hinge '{name}' (dof {dof}) has no actuator with joint= on it: backlash sits between a motor and its "
-                "link, and an unactuated hinge has no motor side"
+                "link, and an unactuated hinge has no motor side",
+                reason=Refusal.NO_ACTUATOR,
+                hinge=name,
             )
         actuated[name] = on_joint
     if any(play.stop == "exact" for play in joints.values()):
@@ -254,6 +266,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     frozen = freeze_inertials(work, twin, adds_bodies=True, cuts_pins=False)
     old_joints = list(work.joints)
     bodies = {int(b.id): b for b in work.bodies}
+    geoms = {int(g.id): g for g in work.geoms}  # by the twin's ids, as bodies
     old_bodies = sorted(bodies)
     actuators = {int(a.id): a for a in work.actuators}
     cls = add_builtin_class(work)
@@ -348,6 +361,10 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
             tendon.solref_limit = list(stop.solref)
             tendon.solimp_limit = list(stop.solimp)
     work.option.timestep = timestep
+    backlashed = {int(twin.joint(name).id) for name in joints}  # their limits go to the motor side: not kept
+    same_joints = [(j, int(s.id)) for j, s in enumerate(old_joints) if j not in backlashed]
+    kept = keep_constraint_softness(work, twin, kinematic, same_joints, timestep)
+    contacts = keep_contact_softness(work, twin, kinematic, geoms, timestep, cls)
     done = {name: BacklashHinge(*pending[name], stops[name], tuple(sensors[name].values())) for name in joints}
     qmap, vmap = joint_index_map(twin, kinematic, [int(j.id) for j in old_joints])
     pairs = [(int(kinematic.joint(h.name).id), int(kinematic.joint(h.motor_joint).id)) for h in done.values()]
@@ -368,6 +385,8 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
         )
         for h in done.values()
     ]
+    if kept or contacts:
+        notes.append(softness_note([(k.label, k.softness) for k in kept] + [(c.label, c.softness) for c in contacts]))
     if frozen:
         notes.append(FROZEN_NOTE)
     if timestep < twin.opt.timestep:

@@ -4,7 +4,9 @@ Checked on every retrofit (radial play and backlash), on the compiled models, so
 reference angle that went astray in the spec edit (degrees written as radians, a reference
 angle left at 0) stops the edit instead of locking a joint: every joint of the unmodified
 model keeps its type, range, limit, reference and spring reference angles (qpos0,
-qpos_spring), limit softness and margin where the map puts it; a backlash motor hinge has its
+qpos_spring) and margin where the map puts it, and its limit's and friction loss's softness
+(R, K and B at the run's step: `clearance.retrofit.softness`, which rescales solimp and solref
+where the edit moved a row's inverse weight); a backlash motor hinge has its
 load's range, limit and reference angle; every keyframe holds the same values; each of the
 model's sensors and actuators reads or drives the same object (a moved one: its motor hinge)
 with the same parameters, and the model's own sensor data keeps its layout.
@@ -17,10 +19,16 @@ from collections.abc import Mapping, Sequence
 import mujoco
 import numpy as np
 
-__all__ = ["JOINT_FIELDS", "check_conventions", "joint_ids"]
+from clearance.retrofit.softness import refsafe, row_softness
 
-JOINT_FIELDS = ("jnt_type", "jnt_limited", "jnt_range", "jnt_margin", "jnt_solref", "jnt_solimp", "jnt_stiffness")
+__all__ = ["JOINT_FIELDS", "SOFTNESS_RTOL", "check_conventions", "joint_ids"]
+
+JOINT_FIELDS = ("jnt_type", "jnt_limited", "jnt_range", "jnt_margin", "jnt_stiffness")
 """Per-joint values an edit keeps, compared exactly (the edit copies them)."""
+
+SOFTNESS_RTOL = 1e-9
+"""Relative tolerance on a limit's or friction loss's R, K and B (`clearance.retrofit.softness.row_softness`):
+where the edit rescaled solimp and solref to keep them, a few roundings of the rescale (1e-15 each)."""
 
 _SENSOR_FIELDS = ("sensor_type", "sensor_datatype", "sensor_dim", "sensor_adr", "sensor_cutoff", "sensor_noise")
 _ACTUATOR_FIELDS = (
@@ -61,6 +69,24 @@ def _same_object(
     return name == _name(model, objtype, b) if name else True  # an unnamed object: nothing to compare it by
 
 
+def _check_softness(twin: mujoco.MjModel, model: mujoco.MjModel, j: int, jm: int, label: str) -> None:
+    """Joint ``j``'s limit and friction loss (first dof) are as soft in ``model`` (joint ``jm``) as in ``twin``."""
+    step, safe = float(model.opt.timestep), refsafe(twin)
+    d, dm = int(twin.jnt_dofadr[j]), int(model.jnt_dofadr[jm])
+    a, am = float(twin.dof_invweight0[d]), float(model.dof_invweight0[dm])
+    rows = [("limit", "jnt", j, jm)] if twin.jnt_limited[j] else []
+    rows += [("friction loss", "dof", d, dm)] if twin.dof_frictionloss[d] > 0 else []
+    for what, kind, i, im in rows:
+        old = row_softness(
+            a, getattr(twin, f"{kind}_solimp")[i], getattr(twin, f"{kind}_solref")[i], step=step, safe=safe
+        )
+        new = row_softness(
+            am, getattr(model, f"{kind}_solimp")[im], getattr(model, f"{kind}_solref")[im], step=step, safe=safe
+        )
+        if not np.allclose(new, old, rtol=SOFTNESS_RTOL, atol=0):
+            _fail(f"joint '{label}': its {what}'s R, K, B {new} instead of {old}")
+
+
 def _fail(what: str) -> None:
     raise RuntimeError(f"the edit changed what the model means: {what}")
 
@@ -94,6 +120,8 @@ def check_conventions(
         for f in JOINT_FIELDS:
             if not np.array_equal(getattr(model, f)[jm], getattr(twin, f)[j]):
                 _fail(f"joint '{label}': {f[4:]} {getattr(model, f)[jm]} instead of {getattr(twin, f)[j]}")
+        if j not in motors:  # a backlashed hinge's limit moved to its motor side with the rotor's inertia
+            _check_softness(twin, model, j, jm, label)
         q = int(twin.jnt_qposadr[j])
         for f in ("qpos0", "qpos_spring"):
             if getattr(model, f)[qpos_map[q]] != getattr(twin, f)[q]:

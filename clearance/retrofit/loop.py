@@ -35,10 +35,9 @@ from clearance.retrofit.frames import BearingFrame, in_plane_axes, placement
 from clearance.retrofit.insertion import PlayElements, add_bearing_frame, prefix_of
 from clearance.retrofit.masses import PIN_INERTIA, Inertial, PointMassSplit, split_point_mass
 from clearance.retrofit.play import RetrofitError
+from clearance.retrofit.softness import Softness, kept_softness, refsafe
 
 __all__ = [
-    "MAX_IMPEDANCE",
-    "ConnectSoftness",
     "Pin",
     "add_pin",
     "check_connect",
@@ -51,12 +50,6 @@ __all__ = [
     "pin_share",
     "soften_like_twin",
 ]
-
-MAX_IMPEDANCE = 0.9999
-"""MuJoCo's largest impedance d (mjMAXIMP)."""
-
-_MIN_IMPEDANCE = 1e-4
-"""MuJoCo's smallest impedance d (mjMINIMP)."""
 
 _OBJ = mujoco.mjtObj
 
@@ -221,36 +214,10 @@ def pin_share(twin: mujoco.MjModel, eq: int, donors: dict[int, Inertial]) -> Poi
     return split
 
 
-@dataclass(frozen=True)
-class ConnectSoftness:
-    """The moved connect's solver parameters and how far they keep the twin's softness.
-
-    Attributes:
-        solimp: (5,) written. solref: (2,) written.
-        inverse_weight: Â of the connect's rows in the twin and with the pin (translational
-            ``body_invweight0`` sums) [1/kg].
-        softer: R(r) of the retrofitted connect over the twin's [-] (1: kept; above 1 where the
-            impedance stopped at `MAX_IMPEDANCE`).
-    """
-
-    solimp: tuple[float, ...]
-    solref: tuple[float, float]
-    inverse_weight: tuple[float, float]
-    softer: float
-
-
-def _impedance_for(d: float, scale: float) -> float:
-    """The impedance whose (1 - d)/d is ``scale`` times ``d``'s, within MuJoCo's range."""
-    rho = (1.0 - d) / d * scale
-    return min(max(1.0 / (1.0 + rho), _MIN_IMPEDANCE), MAX_IMPEDANCE)
-
-
-def connect_softness(twin: mujoco.MjModel, model: mujoco.MjModel, eq: int, step: float) -> ConnectSoftness:
-    """The solimp and solref that give the moved connect ``eq`` the twin's R(r), K and B (module docstring).
-
-    K and B are the twin's at the time step ``step`` both models run at (MuJoCo raises a time
-    constant below 2 ``step`` to 2 ``step`` unless the model disables that): a rescaled time
-    constant that would fall below it is written in direct mode (negative solref) instead.
+def connect_softness(twin: mujoco.MjModel, model: mujoco.MjModel, eq: int, step: float) -> Softness:
+    """The solimp and solref that give the moved connect ``eq`` the twin's R(r), K and B (module docstring;
+    `clearance.retrofit.softness.kept_softness` at the connect's Â, the translational ``body_invweight0``
+    sums of its two bodies).
 
     Args:
         twin: the unmodified model.
@@ -260,22 +227,7 @@ def connect_softness(twin: mujoco.MjModel, model: mujoco.MjModel, eq: int, step:
     """
     a_old = float(twin.body_invweight0[twin.eq_obj1id[eq], 0] + twin.body_invweight0[twin.eq_obj2id[eq], 0])
     a_new = float(model.body_invweight0[model.eq_obj1id[eq], 0] + model.body_invweight0[model.eq_obj2id[eq], 0])
-    scale = a_old / a_new
-    old = [float(v) for v in twin.eq_solimp[eq]]
-    d0, dw = (min(max(d, _MIN_IMPEDANCE), MAX_IMPEDANCE) for d in old[:2])
-    n0, nw = _impedance_for(d0, scale), _impedance_for(dw, scale)
-    softer = max(((1 - n0) / n0) / ((1 - d0) / d0 * scale), ((1 - nw) / nw) / ((1 - dw) / dw * scale))
-    ref = [float(v) for v in twin.eq_solref[eq]]
-    safe = not int(twin.opt.disableflags) & int(mujoco.mjtDisableBit.mjDSBL_REFSAFE)
-    if ref[0] > 0:  # K = 1/(dmax^2 tc^2 zeta^2), B = 2/(dmax tc): the same K and B at dmax = nw
-        tc = max(ref[0], 2 * step) if safe else ref[0]
-        solref = (tc * dw / nw, ref[1])
-        if safe and solref[0] < 2 * step:  # MuJoCo would raise it: direct mode, which it leaves alone
-            k, b = 1 / (dw * tc * ref[1]) ** 2, 2 / (dw * tc)
-            solref = (-k * nw**2, -b * nw)
-    else:  # direct: K = -S/dmax^2, B = -D/dmax
-        solref = (ref[0] * (nw / dw) ** 2, ref[1] * nw / dw)
-    return ConnectSoftness((n0, nw, *old[2:]), solref, (a_old, a_new), softer)
+    return kept_softness(a_old, a_new, twin.eq_solimp[eq], twin.eq_solref[eq], step=step, refsafe=refsafe(twin))
 
 
 @dataclass(frozen=True)
@@ -287,7 +239,7 @@ class Pin:
     """
 
     share: PointMassSplit
-    softness: ConnectSoftness
+    softness: Softness
 
 
 def soften_like_twin(

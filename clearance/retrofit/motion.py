@@ -22,7 +22,7 @@ from clearance.retrofit.loop import connect_load
 from clearance.retrofit.play import ControlTable, RetrofitError, SineControl
 from clearance.retrofit.selection import Hinge
 
-__all__ = ["Motion", "control_signal", "initial_data", "fired_warnings", "twin_motion"]
+__all__ = ["Motion", "control_signal", "initial_data", "fired_warnings", "scalar_coordinates", "twin_motion"]
 
 
 def control_signal(model: mujoco.MjModel, control: SineControl | ControlTable, times: np.ndarray) -> np.ndarray:
@@ -126,3 +126,15 @@ def twin_motion(
             loads[h.name][i] = f[:2]
         mujoco.mj_step(model, data)
     return Motion(times[:done], qpos[:done], {k: v[:done] for k, v in loads.items()}, fired_warnings(data))
+
+
+def scalar_coordinates(model: mujoco.MjModel) -> np.ndarray:
+    """qpos indices of every hinge and slide, and of every free joint's position (no quaternion entries)."""
+    out: list[int] = []
+    for j in range(model.njnt):
+        kind, adr = int(model.jnt_type[j]), int(model.jnt_qposadr[j])
+        if kind in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
+            out.append(adr)
+        elif kind == int(mujoco.mjtJoint.mjJNT_FREE):
+            out += [adr, adr + 1, adr + 2]
+    return np.array(out, dtype=int)

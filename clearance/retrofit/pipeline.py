@@ -24,7 +24,8 @@ from clearance.model import Joint, JointType
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
 from clearance.retrofit.accuracy import Miss, fit_miss, refuse_or_warn, ripple_miss
 from clearance.retrofit.contact import PlayContact, play_contact, row_inverse_weight, write_pair_contact
-from clearance.retrofit.conventions import check_conventions
+from clearance.retrofit.contact_softness import keep_contact_softness
+from clearance.retrofit.conventions import check_conventions, joint_ids
 from clearance.retrofit.coordinates import CoordinateMap, check_map, coordinate_map, extend_keyframes
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.frames import BearingFrame, bearing_frame
@@ -42,6 +43,7 @@ from clearance.retrofit.sizing import (
     effective_masses,
     size_play,
 )
+from clearance.retrofit.softness import keep_constraint_softness, softness_note
 from clearance.retrofit.speed import Clock, SpeedCost, measure_speed
 
 __all__ = ["RetrofittedHinge", "Retrofit", "retrofit", "INTEGRATORS", "EXACT_SOURCE"]
@@ -239,6 +241,7 @@ def retrofit(
         if freeze_inertials(work, twin, adds_bodies=pinned, cuts_pins=pinned):
             notes.append(FROZEN_NOTE)
         bodies = _spec_bodies(work)
+        geoms = {int(g.id): g for g in work.geoms}  # by the twin's ids, as bodies
         cls = add_builtin_class(work)
         elements: dict[str, PlayElements] = {}
         donors: dict[int, Inertial] = {}
@@ -283,6 +286,11 @@ def retrofit(
     for name, s in sizings.items():
         check_time_step(name, s, step)
     pins = {n: soften_like_twin(work, twin, kinematic, n, share, step) for n, share in shares.items()}
+    same_joints = list(enumerate(joint_ids(twin, kinematic, cmap.qpos)))
+    kept = keep_constraint_softness(work, twin, kinematic, same_joints, step, skip=set(shares))
+    contacts = keep_contact_softness(work, twin, kinematic, geoms, step, cls)
+    if kept or contacts:
+        notes.append(softness_note([(k.label, k.softness) for k in kept] + [(c.label, c.softness) for c in contacts]))
 
     integrator = INTEGRATORS.get(mujoco.mjtIntegrator(int(twin.opt.integrator)), "implicitfast")
     if options.contact_mode is ContactMode.CALIBRATED and integrator not in ("implicitfast", "euler"):

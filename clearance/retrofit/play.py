@@ -9,6 +9,7 @@ unless given), and the motion the loads and masses are sized from.
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass, field
 
@@ -30,6 +31,7 @@ __all__ = [
     "DEFAULT_RADIAL_CLEARANCE",
     "PREFIX",
     "RadialPlay",
+    "Refusal",
     "RetrofitError",
     "RetrofitOptions",
     "SineControl",
@@ -50,8 +52,29 @@ DEFAULT_BEARING_RADIUS = 0.010
 """Bearing radius R_B when none is given [m] (10 mm, the catalogue's)."""
 
 
+class Refusal(enum.Enum):
+    """Why a hinge cannot take a kind of play: the reasons a refusal lists (`RetrofitError.reason`)."""
+
+    NOT_A_HINGE = "not a hinge (a slide, ball or free joint)"
+    SHARED_BODY = "shares its body with other joints (a compound joint or a planar base)"
+    NO_ACTUATOR = "no actuator of its own (backlash sits between a motor and its link)"
+    TENDON_DRIVEN = "driven through a tendon (backlash moves only actuators with joint=)"
+    TOO_LIGHT = "too light for its bearing or stop: it needs a time step below 1e-7 s"
+    INACCURATE = "its ring misses its stated accuracy (ripple bound or calibration goals)"
+
+
 class RetrofitError(ValueError):
-    """A model or a request that cannot be retrofitted; the message names the joint, file or value."""
+    """A model or a request that cannot be retrofitted; the message names the joint, file or value.
+
+    Attributes:
+        reason: the listed reason where the refusal is about one hinge's nature (`Refusal`), else None.
+        hinge: that hinge, or None.
+    """
+
+    def __init__(self, message: str, *, reason: Refusal | None = None, hinge: str | None = None) -> None:
+        super().__init__(message)
+        self.reason = reason
+        self.hinge = hinge
 
 
 @dataclass(frozen=True)

@@ -10,11 +10,11 @@ import numpy as np
 from clearance.contact_calibration.fit import GOALS
 from clearance.options import ContactMode
 from clearance.retrofit.insertion import bearing_frame_name
-from clearance.retrofit.loop import MAX_IMPEDANCE
 from clearance.retrofit.masses import PIN_INERTIA, body_label
 from clearance.retrofit.pipeline import Retrofit, RetrofittedHinge
 from clearance.retrofit.play import DEFAULT_CLASS, SineControl
 from clearance.retrofit.sizing import STEP_OMEGA_H
+from clearance.retrofit.softness import MAX_IMPEDANCE
 
 __all__ = ["retrofit_report"]
 

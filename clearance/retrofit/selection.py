@@ -16,9 +16,9 @@ from dataclasses import dataclass
 import mujoco
 
 from clearance.retrofit.loop import check_connect
-from clearance.retrofit.play import DEFAULT_CLASS, PREFIX, RetrofitError
+from clearance.retrofit.play import DEFAULT_CLASS, PREFIX, Refusal, RetrofitError
 
-__all__ = ["Hinge", "compile_model", "select_hinges", "hinge_names"]
+__all__ = ["Hinge", "compile_model", "hinge_names", "joint_kind", "select_hinges"]
 
 _OBJ = mujoco.mjtObj
 _JOINT_KIND = {
@@ -71,6 +71,11 @@ class Hinge:
         return self.equality_id >= 0
 
 
+def joint_kind(model: mujoco.MjModel, joint: int) -> str:
+    """How a message names a joint's type: 'a hinge', 'a slide joint', 'a ball joint' or 'a free joint'."""
+    return _JOINT_KIND[mujoco.mjtJoint(int(model.jnt_type[joint]))]
+
+
 def model_label(spec: mujoco.MjSpec) -> str:
     """How messages name a model: its name, or 'the model'."""
     return f"model '{spec.modelname}'" if spec.modelname else "the model"
@@ -85,11 +90,13 @@ def compile_model(spec: mujoco.MjSpec) -> mujoco.MjModel:
 
 
 def hinge_names(model: mujoco.MjModel) -> list[str]:
-    """Names of the model's named hinges, in joint order."""
+    """Names of the model's named hinges that can take radial play (each the only joint of its body), in
+    joint order: what a refusal lists as the hinges there are."""
     out = []
     for j in range(model.njnt):
         name = mujoco.mj_id2name(model, _OBJ.mjOBJ_JOINT, j)
-        if name and model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
+        alone = model.body_jntnum[model.jnt_bodyid[j]] == 1
+        if name and alone and model.jnt_type[j] == mujoco.mjtJoint.mjJNT_HINGE:
             out.append(name)
     return out
 
@@ -186,14 +193,16 @@ def select_hinges(spec: mujoco.MjSpec, model: mujoco.MjModel, names: Sequence[st
                 continue
             listed = ", ".join(hinges) if hinges else "none"
             raise RetrofitError(
-                f"joint '{n}' does not exist in {label}; its named hinges are: {listed} (a connect equality can be "
-                "named too)"
+                f"joint '{n}' does not exist in {label}; its hinges that can take radial play are: {listed} (a "
+                "connect equality can be named too)"
             )
         kind = mujoco.mjtJoint(int(model.jnt_type[jid]))
         if kind != mujoco.mjtJoint.mjJNT_HINGE:
             raise RetrofitError(
                 f"joint '{n}' is {_JOINT_KIND[kind]}: only a hinge can be given radial play "
-                f"(hinges of {label}: {', '.join(hinges) or 'none'})"
+                f"(hinges of {label} that can: {', '.join(hinges) or 'none'})",
+                reason=Refusal.NOT_A_HINGE,
+                hinge=n,
             )
         body = int(model.jnt_bodyid[jid])
         if model.body_jntnum[body] != 1:
@@ -206,7 +215,9 @@ def select_hinges(spec: mujoco.MjSpec, model: mujoco.MjModel, names: Sequence[st
             bname = mujoco.mj_id2name(model, _OBJ.mjOBJ_BODY, body) or f"#{body}"
             raise RetrofitError(
                 f"hinge '{n}' shares body '{bname}' with other joints ({', '.join(others)}): radial play needs a "
-                "body whose only joint is the hinge"
+                f"body whose only joint is the hinge (hinges of {label} that can: {', '.join(hinges) or 'none'})",
+                reason=Refusal.SHARED_BODY,
+                hinge=n,
             )
         out.append(Hinge(n, jid, body, int(model.body_parentid[body])))
     return out

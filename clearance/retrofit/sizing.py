@@ -32,12 +32,13 @@ import numpy as np
 
 from clearance.contact_calibration.effective_mass import LIGHT_LOAD
 from clearance.contact_calibration.laws import bearing_stiffness, contact_omega
+from clearance.contact_calibration.torsional_stop import MIN_TIMESTEP
 from clearance.mjcf.bearing import RingGeometry, band_ripple, choose_segments
 from clearance.model import Clearance
 from clearance.retrofit.coordinates import CoordinateMap
 from clearance.retrofit.frames import BearingFrame
 from clearance.retrofit.motion import Motion
-from clearance.retrofit.play import RetrofitError
+from clearance.retrofit.play import Refusal, RetrofitError
 from clearance.retrofit.selection import Hinge
 
 __all__ = [
@@ -227,11 +228,26 @@ def size_play(
 
 
 def choose_time_step(sizings: Mapping[str, PlaySizing], model_step: float) -> float:
-    """The largest 1, 2 or 5 x 10^k s with ω h <= `STEP_OMEGA_H` at every bearing, at most ``model_step``."""
+    """The largest 1, 2 or 5 x 10^k s with ω h <= `STEP_OMEGA_H` at every bearing, at most ``model_step``.
+
+    Raises:
+        RetrofitError: the step needed is below `MIN_TIMESTEP` (the backlash stop's floor too), naming the
+            hinge with the stiffest bearing.
+    """
     omega = max((s.omega for s in sizings.values()), default=0.0)
     if omega <= 0:
         return model_step
     target = STEP_OMEGA_H / omega
+    if target < MIN_TIMESTEP:
+        name, worst = max(sizings.items(), key=lambda item: item[1].omega)
+        raise RetrofitError(
+            f"hinge '{name}': its bearing needs a time step of {target:.3g} s (omega = {worst.omega:.4g} rad/s on an "
+            f"effective mass of {worst.effective_mass:.3g} kg), below the smallest allowed {MIN_TIMESTEP:g} s: what "
+            "the hinge carries is too light for its bearing; give those links their real mass, give the play a softer "
+            "material (--youngs-modulus-gpa), or leave this hinge out",
+            reason=Refusal.TOO_LIGHT,
+            hinge=name,
+        )
     exp = math.floor(math.log10(target))
     steps = [float(f"{mant}e{e}") for e in (exp - 1, exp, exp + 1) for mant in (1, 2, 5)]  # decimal values
     return min(max(h for h in steps if h <= target * (1 + 1e-12)), model_step)

@@ -17,9 +17,10 @@ the model's connect equalities (`clearance.retrofit.loop.connect_residual`: what
 constraint rows solve for; a loop closure given play ties body1's anchor to its pin, so it
 reads the connect's own softness and the journal's eccentricity reads the play). The world
 positions of the sites asked for (a site, or a body's origin where no site has the name:
-gymnasium's reacher names its tip a body) are ``outputs`` ``site/<name>/x``, ``/y`` and ``/z``. A backlash retrofit's run has no
-journals: per backlashed hinge its outputs ``backlash/<hinge>/angle`` (q_load - q_motor) and
-``backlash/<hinge>/torque`` (the stop's torque; `clearance.run.backlash_readout`).
+gymnasium's reacher names its tip a body) are ``outputs`` ``site/<name>/x``, ``/y`` and ``/z``.
+A backlash retrofit's run has no journals: per backlashed hinge its outputs
+``backlash/<hinge>/angle`` (q_load - q_motor) and ``backlash/<hinge>/torque`` (the stop's torque;
+`clearance.run.backlash_readout`).
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ from clearance.results import JointResult, SimulationResult
 from clearance.retrofit.drive import Drive, drive_controls
 from clearance.retrofit.loop import connect_residual
 from clearance.retrofit.manifest import BacklashRecord, HingeRecord, RetrofitManifest, read_manifest
-from clearance.retrofit.motion import initial_data
+from clearance.retrofit.motion import initial_data, scalar_coordinates
 from clearance.retrofit.play import RetrofitError
 from clearance.run.backlash_readout import BacklashReader, add_backlash_sensors
 from clearance.run.readout import _exact_contact_force
@@ -158,6 +159,7 @@ def simulate_retrofitted(
     output_interval: float | None = None,
     progress: Callable[[float], None] | None = None,
     chunk_steps: int = 50_000,
+    perturbation: float = 0.0,
 ) -> SimulationResult:
     """Run the retrofitted model (or, with ``twin``, the unmodified one) from its first keyframe.
 
@@ -170,6 +172,8 @@ def simulate_retrofitted(
         output_interval: interval of stored rows [s]; default every step.
         progress: called with the fraction done after each chunk.
         chunk_steps: steps per `mujoco.rollout` call.
+        perturbation: added to every hinge and slide coordinate of the first keyframe [rad or m]
+            (`clearance.run.sensitivity`: a rounding-size nudge that shows chaos); 0: none.
 
     Raises:
         ValueError: a bad duration or interval; `RetrofitError` an unknown site (before any work).
@@ -187,6 +191,8 @@ def simulate_retrofitted(
     nstep = max(1, int(round(duration / h)))
     every = 1 if output_interval is None else max(1, int(round(output_interval / h)))
     data = initial_data(model)
+    if perturbation:
+        data.qpos[scalar_coordinates(model)] += perturbation
     reader = _Reader(model, hinges, sites, backlash)
     step = model_stepper(model, data)
     parts: list[SimulationResult] = []

@@ -29,6 +29,7 @@ from clearance.retrofit.pipeline import retrofit
 from clearance.retrofit.play import Backlash, RadialPlay, RetrofitOptions
 from clearance.run.backlash_readout import add_backlash_sensors
 from clearance.run.retrofitted import Retrofitted, retrofitted, simulate_retrofitted, site_output_names
+from clearance.run.sensitivity import CHAOS_SHARE, point_distance, twin_sensitivity
 
 __all__ = [
     "FACTOR",
@@ -66,12 +67,15 @@ class ZeroPlay:
         duration: simulated time [s].
         deviation: largest distance between the point in the retrofitted model and in the twin [m].
         play: the geometric play at the point (module docstring) [m].
+        sensitivity: how far the point of the twin drifts under a rounding-size nudge of its start
+            [m] (`clearance.run.sensitivity`), None where not measured.
     """
 
     site: str
     duration: float
     deviation: float
     play: float
+    sensitivity: float | None = None
 
     @property
     def bound(self) -> float:
@@ -82,6 +86,12 @@ class ZeroPlay:
     def holds(self) -> bool:
         """Whether the point stayed within the bound."""
         return self.deviation <= self.bound
+
+    @property
+    def chaotic(self) -> bool:
+        """Whether the twin is chaotic at the check's scale: nudged by rounding, it drifts `CHAOS_SHARE` of the
+        bound or more (then a drift beyond the bound cannot be told from chaos); False where not measured."""
+        return self.sensitivity is not None and self.sensitivity >= CHAOS_SHARE * self.bound
 
 
 def _points(result: SimulationResult, site: str) -> np.ndarray:
@@ -114,7 +124,13 @@ def geometric_play(loaded: Retrofitted, twin_run: SimulationResult, site: str) -
 
 
 def zero_play(
-    loaded: Retrofitted, drive: Drive, duration: float, site: str, *, output_interval: float | None = None
+    loaded: Retrofitted,
+    drive: Drive,
+    duration: float,
+    site: str,
+    *,
+    output_interval: float | None = None,
+    chaos: bool = False,
 ) -> ZeroPlay:
     """Run a retrofit given (almost) no play and its twin under ``drive``; how far ``site`` drifts.
 
@@ -125,6 +141,7 @@ def zero_play(
         duration: simulated time [s] (0.1 s is the check's).
         site: a site or body of both models (`clearance.run.retrofitted.point_of`).
         output_interval: rows kept [s] (the drift is read on them; default every step).
+        chaos: also run the twin nudged by rounding (`clearance.run.sensitivity`: ``sensitivity``).
 
     Raises:
         SimulationError: a run diverged (the check fails loudly).
@@ -133,9 +150,15 @@ def zero_play(
         simulate_retrofitted(loaded, drive, duration, twin=twin, sites=[site], output_interval=output_interval)
         for twin in (False, True)
     ]
-    n = min(len(r.times) for r in runs)
-    drift = float(np.max(np.linalg.norm(_points(runs[0], site)[:n] - _points(runs[1], site)[:n], axis=1)))
-    return ZeroPlay(site, duration, drift, geometric_play(loaded, runs[1], site))
+    drift = float(np.max(point_distance(runs[0], runs[1], site)))
+    nudged = twin_sensitivity(loaded, drive, runs[1], site, output_interval=output_interval) if chaos else None
+    return ZeroPlay(
+        site,
+        duration,
+        drift,
+        geometric_play(loaded, runs[1], site),
+        None if nudged is None else nudged.max_distance,
+    )
 
 
 def radial_at_zero(spec: mujoco.MjSpec, joints: Sequence[str], mode: ContactMode, *, segments: int = 64) -> Retrofitted:
