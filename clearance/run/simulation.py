@@ -17,6 +17,7 @@ import numpy as np
 from mujoco import rollout
 
 from clearance.checks import finite
+from clearance.contact_plugin.onsets import record_closed_contacts
 from clearance.model import DriveKind, Mechanism
 from clearance.options import ContactParameters, ModelOptions
 from clearance.results import SimulationResult
@@ -289,6 +290,7 @@ def start_data(model: mujoco.MjModel, qpos0: np.ndarray | None = None) -> mujoco
         mujoco.mj_forward(model, data)
     finally:
         model.opt.integrator = integrator
+    record_closed_contacts(model, data)  # a journal starting in contact: δ̇⁻ at the state's rates
     v = data.qvel - 0.5 * model.opt.timestep * data.qacc
     rows = _equality_rows(model, data)
     if len(rows):
