@@ -205,7 +205,7 @@ def test_cli_retrofits_a_connect(tmp_path, capsys):
     argv += ["--accept-inaccurate"]  # the coarse ring misses its ripple bound: kept, with a warning
     assert main(argv) == 0
     out = capsys.readouterr().out
-    assert "loop: c = 0.2 mm" in out and "warning: accuracy not met, kept with --accept-inaccurate" in out
+    assert "loop: c = 200 µm" in out and "warning: accuracy not met, kept with --accept-inaccurate" in out
     written = mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "model.xml"))  # stock MuJoCo opens it
     assert mujoco.mj_name2id(written, mujoco.mjtObj.mjOBJ_BODY, "clr_loop__pin") >= 0
 

@@ -109,9 +109,13 @@ def test_cli_sizes_from_a_control_file(runs, tmp_path, capsys):
     argv += ["--sizing-control", str(ctrl), "--sizing-duration-s", "0.012"]
     assert main(argv) == 0
     stdout = capsys.readouterr().out
-    peak = float(stdout.split("peak load ")[1].split(" N")[0])
-    # the same motion as the native sizing's: its peak load to the printed 3 digits
-    assert peak == pytest.approx(a.metadata["sizing"]["crank_rod"]["peak_load"], rel=5e-3)
+    assert "crank_rod: c = 500 µm" in stdout
+    lines = (tmp_path / "out" / "retrofit.md").read_text().splitlines()
+    table = next(i for i, x in enumerate(lines) if x.startswith("| hinge | median load [N] | peak load [N] |"))
+    row = next(x for x in lines[table:] if x.startswith("| crank_rod |"))
+    peak = float(row.split("|")[3])  # the sizing table's peak load [N], 4 significant digits
+    # the same motion as the native sizing's: its peak load to the table's 4 digits (half a unit: 5e-4)
+    assert peak == pytest.approx(a.metadata["sizing"]["crank_rod"]["peak_load"], rel=5e-4)
     ctrl.write_text("time_s,crank,extra\n0,1,2\n")
     assert main([*argv[:4], "--out", str(tmp_path / "never"), "--sizing-control", str(ctrl)]) == 2
     assert "unknown actuator 'extra'" in capsys.readouterr().err
