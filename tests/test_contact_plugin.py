@@ -20,6 +20,7 @@ import mujoco
 import numpy as np
 import pytest
 from mujoco import rollout
+from plugin_scenes import add_joint, planar_body
 
 import clearance.contact_plugin as cp
 from clearance.contact_calibration import laws
@@ -80,27 +81,12 @@ def _spec(
     spec.option.integrator = integrator
     rotated = tuple(frame_quat) != (1, 0, 0, 0)
     frame = spec.worldbody.add_body(name="frame", quat=list(frame_quat)) if rotated else spec.worldbody
-    bodies = {}
     for name in ("bearing", "journal"):
-        body = frame.add_body(name=name)
-        if name == "journal" or moving_bearing:
-            for joint, kind, axis in (
-                ("x", "SLIDE", [1, 0, 0]),
-                ("y", "SLIDE", [0, 1, 0]),
-                ("spin", "HINGE", [0, 0, 1]),
-            ):
-                body.add_joint(name=f"{name}_{joint}", axis=axis, type=getattr(mujoco.mjtJoint, f"mjJNT_{kind}"))
-        body.explicitinertial = True
-        body.mass = MASS
-        body.inertia = [INERTIA] * 3
-        body.add_site(name=name)
-        bodies[name] = body
+        moving = name == "journal" or moving_bearing
+        planar_body(frame, name, mass=MASS, inertia=INERTIA, prefix=f"{name}_", moving=moving)
     parameters = {**_law_parameters(law), **law_kw}
-    attributes.add_journal_bearing(
+    add_joint(
         spec,
-        name="joint",
-        journal_site="journal",
-        bearing_site="bearing",
         clearance=C,
         journal_radius=R_J,
         law=law,
@@ -602,11 +588,8 @@ def test_bad_attributes_are_refused_in_python(change: dict, message: str) -> Non
 def test_duplicate_name_and_sensor_lookup() -> None:
     spec = _spec(LN)
     with pytest.raises(ValueError, match="name 'joint' is already used"):
-        attributes.add_journal_bearing(
+        add_joint(
             spec,
-            name="joint",
-            journal_site="journal",
-            bearing_site="bearing",
             clearance=C,
             journal_radius=R_J,
             law=ContactLaw.HERTZ,
@@ -644,11 +627,8 @@ def test_without_the_library_the_compiled_mode_is_refused(monkeypatch) -> None:
     spec.worldbody.add_body(name="bearing").add_site(name="bearing")
     spec.worldbody.add_body(name="journal").add_site(name="journal")
     with pytest.raises(cp.PluginUnavailableError) as err:
-        attributes.add_journal_bearing(
+        add_joint(
             spec,
-            name="joint",
-            journal_site="journal",
-            bearing_site="bearing",
             clearance=C,
             journal_radius=R_J,
             law=LN,

@@ -8,6 +8,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 import pytest
+from plugin_scenes import add_joint, planar_body
 from test_contact_plugin import R_J, C, needs_plugin
 
 from clearance import ModelOptions, simulate
@@ -42,18 +43,9 @@ def _scene(law: ContactLaw) -> tuple[mujoco.MjModel, object]:
     spec.option.gravity = [0, 0, 0]
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
     spec.worldbody.add_site(name="bearing")
-    body = spec.worldbody.add_body(name="journal")
-    for joint, kind, axis in (("x", "SLIDE", [1, 0, 0]), ("y", "SLIDE", [0, 1, 0]), ("spin", "HINGE", [0, 0, 1])):
-        body.add_joint(name=joint, axis=axis, type=getattr(mujoco.mjtJoint, f"mjJNT_{kind}"))
-    body.explicitinertial = True
-    body.mass = 0.15
-    body.inertia = [1e-5] * 3
-    body.add_site(name="journal")
-    attributes.add_journal_bearing(
+    planar_body(spec.worldbody, "journal", mass=0.15, inertia=1e-5)
+    add_joint(
         spec,
-        name="joint",
-        journal_site="journal",
-        bearing_site="bearing",
         clearance=C,
         journal_radius=R_J,
         law=law,

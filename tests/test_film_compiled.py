@@ -15,6 +15,7 @@ from pathlib import Path
 import mujoco
 import numpy as np
 import pytest
+from plugin_scenes import add_joint, planar_body
 from test_contact_plugin import LN, K, needs_plugin
 
 from clearance import ModelOptions, simulate
@@ -36,18 +37,9 @@ def _free_pair(film: FilmModel) -> mujoco.MjModel:
     spec.option.gravity = [0, 0, 0]
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_RK4
     for name in ("bearing", "journal"):
-        body = spec.worldbody.add_body(name=name)
-        for joint, kind, axis in (("x", "SLIDE", [1, 0, 0]), ("y", "SLIDE", [0, 1, 0]), ("spin", "HINGE", [0, 0, 1])):
-            body.add_joint(name=f"{name}_{joint}", axis=axis, type=getattr(mujoco.mjtJoint, f"mjJNT_{kind}"))
-        body.explicitinertial = True
-        body.mass = 0.15
-        body.inertia = [1e-5] * 3
-        body.add_site(name=name)
-    attributes.add_journal_bearing(
+        planar_body(spec.worldbody, name, mass=0.15, inertia=1e-5, prefix=f"{name}_")
+    add_joint(
         spec,
-        name="joint",
-        journal_site="journal",
-        bearing_site="bearing",
         clearance=C,
         journal_radius=R_J,
         law=LN,
