@@ -33,13 +33,13 @@ from every force but the joint's own, and its whole velocity change), per instan
 from __future__ import annotations
 
 import math
-from typing import Any
 
 import mujoco
 
 from clearance.contact_calibration import laws
 from clearance.contact_calibration.cylindrical_laws import CylinderLaw, cylinder_law
-from clearance.contact_plugin import PLUGIN_NAME, require
+from clearance.contact_plugin import PLUGIN_NAME
+from clearance.contact_plugin.instances import add_instance, number_attribute, sensor_block, site_of
 from clearance.lubrication import Lubrication
 from clearance.model import CYLINDRICAL_LAWS, Clearance, ContactLaw
 
@@ -54,8 +54,6 @@ __all__ = [
     "sensor_offsets",
     "state_address",
     "state_size",
-    "number_attribute",
-    "site_of",
 ]
 
 SENSOR_FIELDS: tuple[str, ...] = (
@@ -119,53 +117,6 @@ def require_compiled_law(law: ContactLaw, joint: str) -> None:
             f"{', '.join(m.value for m in COMPILED_LAWS)}); run it with contact_mode 'nominal' or 'calibrated', "
             "or in the reference solver"
         )
-
-
-def number_attribute(
-    contact: str, attribute: str, value: Any, expected: str, ok: Any, what: str = "journal-bearing contact"
-) -> float:
-    """``value`` as a float if finite and ``ok(value)``, else a ValueError saying what was expected.
-
-    Args:
-        contact: the contact's name, for the message.
-        attribute: the attribute's name.
-        value: the value given.
-        expected: what was expected, in words (with the unit).
-        ok: a predicate on the float.
-        what: the kind of contact, for the message.
-
-    Raises:
-        ValueError: ``value`` not a finite number or ``ok`` false.
-    """
-    if isinstance(value, bool) or not isinstance(value, (int, float)):
-        raise ValueError(f"{what} '{contact}': {attribute} must be a number {expected} (got {value!r})")
-    v = float(value)
-    if not (math.isfinite(v) and ok(v)):
-        raise ValueError(f"{what} '{contact}': {attribute} must be finite and {expected} (got {value!r})")
-    return v
-
-
-def site_of(
-    spec: mujoco.MjSpec, contact: str, attribute: str, name: Any, what: str = "journal-bearing contact"
-) -> mujoco.MjsSite:
-    """The spec's site named ``name``, else a ValueError naming the contact and the attribute.
-
-    Args:
-        spec: the model under construction.
-        contact: the contact's name, for the message.
-        attribute: the attribute that names the site.
-        name: the site's name.
-        what: the kind of contact, for the message.
-
-    Raises:
-        ValueError: ``name`` not a non-empty string or no such site.
-    """
-    if not isinstance(name, str) or not name:
-        raise ValueError(f"{what} '{contact}': {attribute} must be a site name (got {name!r})")
-    site = spec.site(name)
-    if site is None:
-        raise ValueError(f"{what} '{contact}': {attribute} = {name!r} is not a site of the spec")
-    return site
 
 
 def add_journal_bearing(
@@ -329,12 +280,7 @@ def add_journal_bearing(
             lambda v: 0 < v < config["clearance"],
         )
 
-    require()
-    spec.activate_plugin(PLUGIN_NAME)
-    plugin = spec.add_plugin(name=name, plugin_name=PLUGIN_NAME, active=True)
-    plugin.config = {k: v if isinstance(v, str) else repr(v) for k, v in config.items()}
-    sensor = spec.add_sensor(name=name, type=mujoco.mjtSensor.mjSENS_PLUGIN)
-    sensor.plugin = plugin
+    add_instance(spec, PLUGIN_NAME, name, config)
 
 
 def add_for_clearance(
@@ -412,10 +358,7 @@ def sensor_address(model: mujoco.MjModel, name: str) -> int:
     Raises:
         ValueError: if the model has no such plugin sensor.
     """
-    i = _id(model, mujoco.mjtObj.mjOBJ_SENSOR, name, "sensor")
-    if model.sensor_type[i] != mujoco.mjtSensor.mjSENS_PLUGIN or model.sensor_dim[i] != len(SENSOR_FIELDS):
-        raise ValueError(f"sensor {name!r} is not a journal-bearing contact sensor")
-    return int(model.sensor_adr[i])
+    return sensor_offsets(model, name)[SENSOR_FIELDS[0]]
 
 
 def sensor_offsets(model: mujoco.MjModel, name: str) -> dict[str, int]:
@@ -431,8 +374,7 @@ def sensor_offsets(model: mujoco.MjModel, name: str) -> dict[str, int]:
     Raises:
         ValueError: if the model has no such plugin sensor.
     """
-    adr = sensor_address(model, name)
-    return {field: adr + k for k, field in enumerate(SENSOR_FIELDS)}
+    return sensor_block(model, name, SENSOR_FIELDS, "journal-bearing")
 
 
 def state_size(model: mujoco.MjModel) -> int:

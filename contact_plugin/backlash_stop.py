@@ -28,15 +28,16 @@ slot  field                unit    meaning
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import mujoco
 
 from clearance.contact_calibration import laws
-from clearance.contact_plugin import require
+from clearance.contact_plugin.instances import add_instance, number_attribute, sensor_block
 
 __all__ = ["PLUGIN_NAME", "SENSOR_FIELDS", "add_backlash_stop", "sensor_offsets"]
+
+_WHAT = "backlash stop"
 
 PLUGIN_NAME = "clearance.backlash_stop"
 """Name under which the library registers the backlash stop with MuJoCo."""
@@ -52,16 +53,6 @@ SENSOR_FIELDS: tuple[str, ...] = (
     "impact_peak_torque",
 )
 """Names of the plugin sensor's values, in order (units in the module docstring)."""
-
-
-def _number(stop: str, attribute: str, value: Any, expected: str, ok: Any) -> float:
-    """``value`` as a float if finite and ``ok(value)``, else a ValueError saying what was expected."""
-    if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(float(value)):
-        raise ValueError(f"backlash stop '{stop}': {attribute} must be a finite number {expected} (got {value!r})")
-    v = float(value)
-    if not ok(v):
-        raise ValueError(f"backlash stop '{stop}': {attribute} must be {expected} (got {value!r})")
-    return v
 
 
 def _hinge(spec: mujoco.MjSpec, stop: str, attribute: str, name: Any) -> str:
@@ -118,18 +109,15 @@ def add_backlash_stop(
     config = {
         "load_joint": load,
         "motor_joint": motor,
-        "half_width": _number(name, "half_width", half_width, "> 0 [rad]", lambda v: v > 0),
-        "stiffness": _number(name, "stiffness", stiffness, "> 0 [N m/rad^n]", lambda v: v > 0),
-        "exponent": _number(name, "exponent", exponent, "> 0", lambda v: v > 0),
-        "restitution": _number(name, "restitution", restitution, "in [0, 1]", lambda v: 0 <= v <= 1),
-        "min_approach_speed": _number(name, "min_approach_speed", min_approach_speed, "> 0 [rad/s]", lambda v: v > 0),
+        "half_width": number_attribute(name, "half_width", half_width, "> 0 [rad]", lambda v: v > 0, _WHAT),
+        "stiffness": number_attribute(name, "stiffness", stiffness, "> 0 [N m/rad^n]", lambda v: v > 0, _WHAT),
+        "exponent": number_attribute(name, "exponent", exponent, "> 0", lambda v: v > 0, _WHAT),
+        "restitution": number_attribute(name, "restitution", restitution, "in [0, 1]", lambda v: 0 <= v <= 1, _WHAT),
+        "min_approach_speed": number_attribute(
+            name, "min_approach_speed", min_approach_speed, "> 0 [rad/s]", lambda v: v > 0, _WHAT
+        ),
     }
-    require()
-    spec.activate_plugin(PLUGIN_NAME)
-    plugin = spec.add_plugin(name=name, plugin_name=PLUGIN_NAME, active=True)
-    plugin.config = {k: v if isinstance(v, str) else repr(v) for k, v in config.items()}
-    sensor = spec.add_sensor(name=name, type=mujoco.mjtSensor.mjSENS_PLUGIN)
-    sensor.plugin = plugin
+    add_instance(spec, PLUGIN_NAME, name, config)
 
 
 def sensor_offsets(model: mujoco.MjModel, name: str) -> dict[str, int]:
@@ -145,8 +133,4 @@ def sensor_offsets(model: mujoco.MjModel, name: str) -> dict[str, int]:
     Raises:
         ValueError: if the model has no such plugin sensor.
     """
-    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, name)
-    if i < 0 or model.sensor_type[i] != mujoco.mjtSensor.mjSENS_PLUGIN or model.sensor_dim[i] != len(SENSOR_FIELDS):
-        raise ValueError(f"the model has no backlash stop sensor named {name!r}")
-    adr = int(model.sensor_adr[i])
-    return {field: adr + k for k, field in enumerate(SENSOR_FIELDS)}
+    return sensor_block(model, name, SENSOR_FIELDS, "backlash stop")

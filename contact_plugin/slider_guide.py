@@ -17,8 +17,7 @@ from __future__ import annotations
 import mujoco
 
 from clearance.contact_calibration import laws
-from clearance.contact_plugin import require
-from clearance.contact_plugin.attributes import number_attribute, site_of
+from clearance.contact_plugin.instances import add_instance, number_attribute, sensor_block, site_of
 from clearance.model import CYLINDRICAL_LAWS, ContactLaw
 from clearance.translational import TranslationalClearance
 
@@ -123,12 +122,7 @@ def add_slider_guide(
             raise ValueError(f"slider-guide contact '{name}': law IMPACT needs c_max [N s/m] and d_max [m]")
         config["c_max"] = number_attribute(name, "c_max", c_max, ">= 0 [N s/m]", lambda v: v >= 0, _WHAT)
         config["d_max"] = number_attribute(name, "d_max", d_max, "> 0 [m]", lambda v: v > 0, _WHAT)
-    require()
-    spec.activate_plugin(SLIDER_PLUGIN_NAME)
-    plugin = spec.add_plugin(name=name, plugin_name=SLIDER_PLUGIN_NAME, active=True)
-    plugin.config = {k: v if isinstance(v, str) else repr(float(v)) for k, v in config.items()}
-    sensor = spec.add_sensor(name=name, type=mujoco.mjtSensor.mjSENS_PLUGIN)
-    sensor.plugin = plugin
+    add_instance(spec, SLIDER_PLUGIN_NAME, name, config)
 
 
 def slider_sensor_offsets(model: mujoco.MjModel, name: str) -> dict[str, int]:
@@ -144,12 +138,4 @@ def slider_sensor_offsets(model: mujoco.MjModel, name: str) -> dict[str, int]:
     Raises:
         ValueError: the model has no such slider-guide sensor.
     """
-    i = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SENSOR, name)
-    if (
-        i < 0
-        or model.sensor_type[i] != mujoco.mjtSensor.mjSENS_PLUGIN
-        or model.sensor_dim[i] != len(SLIDER_SENSOR_FIELDS)
-    ):
-        raise ValueError(f"the model has no slider-guide contact sensor named {name!r}")
-    adr = int(model.sensor_adr[i])
-    return {field: adr + k for k, field in enumerate(SLIDER_SENSOR_FIELDS)}
+    return sensor_block(model, name, SLIDER_SENSOR_FIELDS, "slider-guide contact")
