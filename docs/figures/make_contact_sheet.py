@@ -183,7 +183,7 @@ def compose(page: Page, columns: list[tuple[str, str, Path]], path: Path, commit
     pen = ImageDraw.Draw(sheet)
     big, small = _font(26), _font(17)
     title = page.mechanism + ("" if page.clearance_at is None else ", a clearance at every joint that can carry one")
-    pen.text((_MARGIN, 14), f"{title}: every figure of its report", font=big, fill="black")
+    pen.text((_MARGIN, 14), title, font=big, fill="black")
     pen.text(
         (_MARGIN, 50),
         f"python docs/figures/make_contact_sheet.py --mechanisms {page.name}   (commit {commit})",
