@@ -42,6 +42,7 @@ from clearance.contact_calibration.torsional_stop import (
     stop_timestep,
 )
 from clearance.retrofit.play import Backlash
+from clearance.retrofit.poses import random_pose
 
 __all__ = [
     "FALLBACK_IMPACT_SPEED",
@@ -138,15 +139,10 @@ def pose_inertias(model: mujoco.MjModel, bands: Mapping[str, Band]) -> dict[str,
     seen = np.zeros((POSE_SAMPLES + 1, len(jacs)))
     x = np.zeros((1, model.nv))
     for i in range(POSE_SAMPLES + 1):
-        data.qpos[:] = model.qpos0
-        for j in range(model.njnt if i else 0):
-            kind = int(model.jnt_type[j])
-            if kind not in (int(mujoco.mjtJoint.mjJNT_HINGE), int(mujoco.mjtJoint.mjJNT_SLIDE)):
-                continue
-            if model.jnt_limited[j]:
-                data.qpos[model.jnt_qposadr[j]] = rng.uniform(*model.jnt_range[j])
-            elif kind == int(mujoco.mjtJoint.mjJNT_HINGE):
-                data.qpos[model.jnt_qposadr[j]] = rng.uniform(-math.pi, math.pi)
+        if i:
+            random_pose(model, rng, data.qpos)
+        else:
+            data.qpos[:] = model.qpos0
         for load, motor in motors:
             data.qpos[motor] = data.qpos[load]
         mujoco.mj_forward(model, data)

@@ -39,6 +39,7 @@ __all__ = [
     "refsafe",
     "row_softness",
     "softness_note",
+    "stiffness_damping",
 ]
 
 MAX_IMPEDANCE = 0.9999
@@ -108,7 +109,7 @@ def kept_softness(
     d0, dw = (min(max(d, MIN_IMPEDANCE), MAX_IMPEDANCE) for d in old[:2])
     n0, nw = _impedance_for(d0, scale), _impedance_for(dw, scale)
     softer = max(((1 - n0) / n0) / ((1 - d0) / d0 * scale), ((1 - nw) / nw) / ((1 - dw) / dw * scale))
-    k, b = _stiffness_damping(dw, solref, step, refsafe)
+    k, b = stiffness_damping(dw, solref, step, refsafe)
     new_ref: tuple[float, float]
     tc = float(solref[0])
     if tc > 0 and (tc := max(tc, 2 * step) if refsafe else tc) * dw / nw >= (2 * step if refsafe else 0):
@@ -118,8 +119,17 @@ def kept_softness(
     return Softness((n0, nw, *old[2:]), new_ref, (a_old, a_new), softer)
 
 
-def _stiffness_damping(dw: float, solref: Sequence[float], step: float, safe: bool) -> tuple[float, float]:
-    """MuJoCo's K and B of a row at dmax = ``dw`` (module docstring)."""
+def stiffness_damping(dw: float, solref: Sequence[float], step: float, safe: bool) -> tuple[float, float]:
+    """MuJoCo's mass-normalised K and B of a row whose solimp's dmax is ``dw`` (module docstring).
+
+    Args:
+        dw: the impedance at the end of solimp's width, dmax [-].
+        solref: (2,): (time constant [s], damping ratio [-]), or direct (-S, -D).
+        step: the time step [s]. safe: whether time constants below 2 ``step`` are raised (refsafe).
+
+    Returns:
+        (K [1/s^2], B [1/s]) of the row's reference acceleration aref = -B v - K d r.
+    """
     tc, zeta = float(solref[0]), float(solref[1])
     if tc > 0:
         tc = max(tc, 2 * step) if safe else tc
@@ -135,7 +145,7 @@ def row_softness(a: float, solimp: Sequence[float], solref: Sequence[float], *, 
         step: the time step [s]. safe: whether time constants below 2 ``step`` are raised (refsafe).
     """
     d0, dw = (min(max(float(d), MIN_IMPEDANCE), MAX_IMPEDANCE) for d in solimp[:2])
-    k, b = _stiffness_damping(dw, solref, step, safe)
+    k, b = stiffness_damping(dw, solref, step, safe)
     return np.array([(1 - d0) / d0 * a, (1 - dw) / dw * a, k * d0, b])
 
 
