@@ -24,24 +24,6 @@ def _rot(th: np.ndarray | float) -> np.ndarray:
     return np.array([[c, -s], [s, c]])
 
 
-def _rotate(th: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """R(th) p for th (..., n) and p (n, 2): (..., n, 2)."""
-    c, s = np.cos(th), np.sin(th)
-    out = np.empty(np.shape(th) + (2,))
-    out[..., 0] = c * p[:, 0] - s * p[:, 1]
-    out[..., 1] = s * p[:, 0] + c * p[:, 1]
-    return out
-
-
-def _rotate_d(th: np.ndarray, p: np.ndarray) -> np.ndarray:
-    """dR/dth(th) p for th (..., n) and p (n, 2): (..., n, 2)."""
-    c, s = np.cos(th), np.sin(th)
-    out = np.empty(np.shape(th) + (2,))
-    out[..., 0] = -s * p[:, 0] - c * p[:, 1]
-    out[..., 1] = c * p[:, 0] - s * p[:, 1]
-    return out
-
-
 @dataclass(frozen=True)
 class _Pair:
     kind: JointType
@@ -163,6 +145,16 @@ class ConstraintSystem:
             [rr * w + 3 * ra + 2, (rr + 1) * w + 3 * ra + 2, rr * w + 3 * rb + 2, (rr + 1) * w + 3 * rb + 2]
             + [(pr + 1) * w + 3 * x + k for x in (pa_, pb_) for k in range(3)]
         ).astype(int)
+        # every link-frame vector that the rows rotate, in one table: (link block, vector) for
+        # the revolute pairs' a and b points, then the prismatic pairs' a and b points and axis
+        # normals; `_rotated` turns them all with one cosine and sine per link
+        pri_a, pri_b = self._pri[1], self._pri[2]
+        self._rot_link = np.concatenate([ra, rb, pri_a, pri_b, pri_a]).astype(int)
+        self._rot_vec = np.concatenate(
+            [self._rev[3], self._rev[4], self._pri[3], self._pri[4], self._pri[5]], axis=0
+        ).reshape(-1, 2)
+        nr, npr = len(rr), len(pr)
+        self._rot_at = np.cumsum([0, nr, nr, npr, npr, npr])
 
     def _ext(self, q: np.ndarray) -> np.ndarray:
         """q (..., nq) -> poses (..., n_links + 1, 3) with the ground block appended."""
@@ -170,20 +162,42 @@ class ConstraintSystem:
         z = np.zeros(q.shape[:-1] + (3,))
         return np.concatenate([q, z], axis=-1).reshape(q.shape[:-1] + (self.n_links + 1, 3))
 
+    def _rotated(self, pose: np.ndarray) -> tuple[list[np.ndarray], list[np.ndarray]]:
+        """R(theta) v and dR/dtheta(theta) v of every vector of the rotation table, (..., k, 2) per
+        group: revolute a, revolute b, prismatic a, prismatic b, prismatic normal.
+
+        The same operations as `_rotate` and `_rotate_d`, with one cosine and sine per link.
+        """
+        th = pose[..., 2]
+        c, s = np.cos(th)[..., self._rot_link], np.sin(th)[..., self._rot_link]
+        px, py = self._rot_vec[:, 0], self._rot_vec[:, 1]
+        rot = np.empty(c.shape + (2,))
+        rot[..., 0] = c * px - s * py
+        rot[..., 1] = s * px + c * py
+        drot = np.empty(c.shape + (2,))
+        drot[..., 0] = -s * px - c * py
+        drot[..., 1] = c * px - s * py
+        at = self._rot_at
+        return (
+            [rot[..., at[k] : at[k + 1], :] for k in range(5)],
+            [drot[..., at[k] : at[k + 1], :] for k in range(5)],
+        )
+
     def phi(self, q: np.ndarray, t: float | np.ndarray = 0.0) -> np.ndarray:
         """Constraint residuals Phi(q, t), shape (..., n_constraints) [m or rad]."""
         pose = self._ext(q)
         out = np.empty(pose.shape[:-2] + (self.n_constraints,))
-        rows, ia, ib, pa, pb, u, off = self._rev
+        (ra_p, rb_p, pa_p, pb_p, n_p), _ = self._rotated(pose)
+        rows, ia, ib = self._rev[:3]
         if len(rows):
-            res = pose[..., ia, :2] + _rotate(pose[..., ia, 2], pa) - pose[..., ib, :2] - _rotate(pose[..., ib, 2], pb)
+            res = pose[..., ia, :2] + ra_p - pose[..., ib, :2] - rb_p
             out[..., rows], out[..., rows + 1] = res[..., 0], res[..., 1]
         rows, ia, ib, pa, pb, u, off = self._pri
         if len(rows):
             tha, thb = pose[..., ia, 2], pose[..., ib, 2]
-            d = pose[..., ib, :2] + _rotate(thb, pb) - pose[..., ia, :2] - _rotate(tha, pa)
+            d = pose[..., ib, :2] + pb_p - pose[..., ia, :2] - pa_p
             out[..., rows] = thb - tha - off
-            out[..., rows + 1] = np.sum(_rotate(tha, u) * d, axis=-1)
+            out[..., rows + 1] = np.sum(n_p * d, axis=-1)
         for k, (d, _, _) in enumerate(self.drives):
             rel = pose[..., self._drv_ib[k], 2] - pose[..., self._drv_ia[k], 2]
             out[..., self._drv_rows[k]] = rel - d.angle(t)
@@ -196,23 +210,19 @@ class ConstraintSystem:
         jac = np.zeros(batch + (self.n_constraints * (self.nq + 3),))
         jac[..., self._jac_const_idx] = self._jac_const_val
         vals = []
-        rows, ia, ib, pa, pb, u, off = self._rev
-        if len(rows):
-            da = _rotate_d(pose[..., ia, 2], pa)
-            db = _rotate_d(pose[..., ib, 2], pb)
+        (_, _, pa_p, pb_p, n), (da, db, pa_d, pb_d, n_d) = self._rotated(pose)
+        if len(self._rev[0]):
             vals += [da[..., 0], da[..., 1], -db[..., 0], -db[..., 1]]
-        rows, ia, ib, pa, pb, u, off = self._pri
+        rows, ia, ib = self._pri[:3]
         if len(rows):
-            tha, thb = pose[..., ia, 2], pose[..., ib, 2]
-            n = _rotate(tha, u)
-            d = pose[..., ib, :2] + _rotate(thb, pb) - pose[..., ia, :2] - _rotate(tha, pa)
+            d = pose[..., ib, :2] + pb_p - pose[..., ia, :2] - pa_p
             vals += [
                 -n[..., 0],
                 -n[..., 1],
-                np.sum(_rotate_d(tha, u) * d - n * _rotate_d(tha, pa), axis=-1),
+                np.sum(n_d * d - n * pa_d, axis=-1),
                 n[..., 0],
                 n[..., 1],
-                np.sum(n * _rotate_d(thb, pb), axis=-1),
+                np.sum(n * pb_d, axis=-1),
             ]
         if vals:
             jac[..., self._jac_var_idx] = np.concatenate(vals, axis=-1)
@@ -230,19 +240,18 @@ class ConstraintSystem:
         """Acceleration right-hand side: Phi_q qdd = gamma, shape (..., n_constraints)."""
         pose, vel = self._ext(q), self._ext(qd)
         out = np.zeros(pose.shape[:-2] + (self.n_constraints,))
-        rows, ia, ib, pa, pb, u, off = self._rev
+        (rev_a, rev_b, ra_p, rb_p, n), (_, _, ra_d, rb_d, n_d) = self._rotated(pose)
+        rows, ia, ib = self._rev[:3]
         if len(rows):
             wa, wb = vel[..., ia, 2:3], vel[..., ib, 2:3]
-            res = wa**2 * _rotate(pose[..., ia, 2], pa) - wb**2 * _rotate(pose[..., ib, 2], pb)
+            res = wa**2 * rev_a - wb**2 * rev_b
             out[..., rows], out[..., rows + 1] = res[..., 0], res[..., 1]
-        rows, ia, ib, pa, pb, u, off = self._pri
+        rows, ia, ib = self._pri[:3]
         if len(rows):
-            tha, thb = pose[..., ia, 2], pose[..., ib, 2]
             wa, wb = vel[..., ia, 2:3], vel[..., ib, 2:3]
-            ra_p, rb_p = _rotate(tha, pa), _rotate(thb, pb)
-            n, nd = _rotate(tha, u), wa * _rotate_d(tha, u)
+            nd = wa * n_d
             d = pose[..., ib, :2] + rb_p - pose[..., ia, :2] - ra_p
-            dd = vel[..., ib, :2] + wb * _rotate_d(thb, pb) - vel[..., ia, :2] - wa * _rotate_d(tha, pa)
+            dd = vel[..., ib, :2] + wb * rb_d - vel[..., ia, :2] - wa * ra_d
             rest = (
                 -(wa[..., 0] ** 2) * np.sum(n * d, axis=-1)
                 + 2 * np.sum(nd * dd, axis=-1)
