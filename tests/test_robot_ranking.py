@@ -14,7 +14,7 @@ import pytest
 from cli_runner import run_cli as _cli
 from gym_assets import gym_model
 
-from clearance.analysis.sweeps.robot_ranking import check_grid, per_period_deviation, rank_plays
+from clearance.analysis.sweeps.robot_ranking import check_grid, per_period_deviation, rank_plays, robot_ranking_markdown
 from clearance.cli import main
 from clearance.model import Clearance, Material
 from clearance.retrofit import Backlash, RadialPlay
@@ -91,6 +91,14 @@ def test_the_ranking_is_rank_joints_over_the_rows(ranked):
             assert s.score == pytest.approx(cell.mean_deviation / size, rel=1e-12)
             assert s.ci_low <= s.score <= s.ci_high
     assert len(ranking.overall.scores) == 4
+    # the markdown says where the order is not a ranking: every pair whose P(above next) is under 95 %
+    text = robot_ranking_markdown(ranking)
+    for r in (ranking.overall, *ranking.by_kind.values()):
+        apart = [s.confidence_above_next >= 0.95 for s in r.scores if np.isfinite(s.confidence_above_next)]
+        assert (f"**Not a ranking:** {apart.count(False)} of {len(apart)} candidates" in text) == (not all(apart))
+    assert text.count("**Not a ranking:**") == sum(
+        any(s.confidence_above_next < 0.95 for s in r.scores) for r in (ranking.overall, *ranking.by_kind.values())
+    )
 
 
 def test_rerunning_the_command_resumes_without_running_again(ranked, capsys):

@@ -45,7 +45,8 @@ def plot_deviation(
     gs = fig.add_gridspec(1, 2, width_ratios=[2, 1], left=0.08, right=0.98, top=0.8, bottom=0.13, wspace=0.22)
     a1, a2 = fig.add_subplot(gs[0, 0]), fig.add_subplot(gs[0, 1])
     d = (y - y0) * scale
-    style = {"lw": 0.7, "color": "C3", "label": "deviation y − y_ideal"}
+    short = output.rsplit("/", 1)[-1]  # a site's coordinate (x, y, z) or the output's own name
+    style = {"lw": 0.7, "color": "C3", "label": f"deviation {short} − {short}_ideal"}
     time = time_axis(result.times)
     lo, hi = stats.band90_low * scale, stats.band90_high * scale
     band = draw_series(a1, t * time.scale, d, style=style, reach=(lo, hi))
@@ -71,14 +72,14 @@ def plot_deviation(
     a2.set_ylabel("samples")
     a2.legend(fontsize=8)
     a2.set_title(
-        "distributions of y: Kolmogorov–Smirnov distance\n"
+        f"distributions of {short}: Kolmogorov–Smirnov distance\n"
         f"{stats.ks_statistic:.3g} (p = {stats.ks_pvalue:.2g}); variance ratio F = {stats.f_statistic:.4g} "
         f"(p = {stats.f_pvalue:.2g})",
         fontsize=8,
     )
     fig.suptitle(
-        f"{output}: mean |deviation| {stats.mean_deviation * scale:.3g} {unit}, "
-        f"RMS {stats.rms_deviation * scale:.3g} {unit} over "
+        f"{output}: mean deviation {stats.mean_signed_deviation * scale:.3g} {unit} (the green line), mean "
+        f"|deviation| {stats.mean_deviation * scale:.3g} {unit}, RMS {stats.rms_deviation * scale:.3g} {unit} over "
         + (
             f"the steady state (from t = {format_quantity(stats.window_start, 's')})"
             if stats.window_start > result.times[0]

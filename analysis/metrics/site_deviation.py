@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import csv
 import io
+from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -19,7 +20,14 @@ import numpy as np
 from clearance.analysis.metrics.statistics import DeviationStatistics, deviation_statistics
 from clearance.results import SimulationResult, atomic_write_text
 
-__all__ = ["MOVING", "SiteDeviation", "site_deviation", "write_site_deviation_csv"]
+__all__ = [
+    "MOVING",
+    "SiteDeviation",
+    "add_frame_outputs",
+    "frame_output_names",
+    "site_deviation",
+    "write_site_deviation_csv",
+]
 
 MOVING = 1e-9
 """A coordinate moves when its range over the twin's run exceeds this [m]."""
@@ -34,12 +42,15 @@ class SiteDeviation:
         axes: output name (``site/<name>/x`` ...) -> its statistics, for each coordinate that moves.
         times: (m,) the window's times [s].
         distance: (m,) |p - p_twin| over the window [m].
+        frame: the body whose frame the positions are in (its origin and axes in each run: a
+            floating base), None for the world.
     """
 
     site: str
     axes: dict[str, DeviationStatistics]
     times: np.ndarray
     distance: np.ndarray
+    frame: str | None = None
 
     @property
     def max_distance(self) -> float:
@@ -47,7 +58,35 @@ class SiteDeviation:
         return float(self.distance.max()) if len(self.distance) else float("nan")
 
 
-def site_deviation(result: SimulationResult, twin: SimulationResult, site: str, *, skip: float = 0.0) -> SiteDeviation:
+def frame_output_names(site: str, frame: str) -> list[str]:
+    """Output names of a site's position in a body's frame: ``site/<name>/in <frame>/x``, ``/y``, ``/z``."""
+    return [f"site/{site}/in {frame}/{a}" for a in "xyz"]
+
+
+def add_frame_outputs(run: SimulationResult, site: str, frame: str) -> list[str]:
+    """Add ``site``'s position in body ``frame``'s frame (R^T (p - x) from the body's pose in each row) to
+    ``run``'s outputs; returns their names (`frame_output_names`).
+
+    Raises:
+        KeyError: the site's world outputs or the body are not in the run (``metadata['bodies']``).
+    """
+    bodies = list(run.metadata.get("bodies", []))
+    if frame not in bodies:
+        raise KeyError(f"body {frame!r} is not in the run (bodies: {bodies})")
+    pose = run.body_poses[:, bodies.index(frame)]
+    p = np.column_stack([run.outputs[f"site/{site}/{a}"] for a in "xyz"]) - pose[:, :3]
+    w, v = pose[:, 3:4], -pose[:, 4:7]  # the inverse rotation: the conjugate quaternion
+    t = 2 * np.cross(v, p)
+    local = p + w * t + np.cross(v, t)
+    names = frame_output_names(site, frame)
+    for k, name in enumerate(names):
+        run.outputs[name] = local[:, k].copy()
+    return names
+
+
+def site_deviation(
+    result: SimulationResult, twin: SimulationResult, site: str, *, skip: float = 0.0, frame: str | None = None
+) -> SiteDeviation:
     """Deviation statistics of ``site`` over the window after ``skip`` [s].
 
     Args:
@@ -55,6 +94,8 @@ def site_deviation(result: SimulationResult, twin: SimulationResult, site: str, 
         twin: the unmodified twin's run (interpolated to ``result``'s times).
         site: the site (or body) name.
         skip: start of the window after the run's first time [s].
+        frame: read the site in this body's frame (outputs `add_frame_outputs` added to both runs);
+            None: the world's.
 
     Returns:
         Per moving coordinate the `DeviationStatistics`, and the distance from the twin's
@@ -64,7 +105,7 @@ def site_deviation(result: SimulationResult, twin: SimulationResult, site: str, 
         KeyError: the site's outputs are not in both runs.
         ValueError: the window holds fewer than 3 samples.
     """
-    names = [f"site/{site}/{a}" for a in "xyz"]
+    names = [f"site/{site}/{a}" for a in "xyz"] if frame is None else frame_output_names(site, frame)
     for n in names:
         if n not in result.outputs or n not in twin.outputs:
             raise KeyError(f"site {site!r} is not an output of both runs (outputs: {sorted(result.outputs)})")
@@ -75,16 +116,20 @@ def site_deviation(result: SimulationResult, twin: SimulationResult, site: str, 
     t = result.times[keep]
     p = np.column_stack([result.outputs[n][keep] for n in names])
     p0 = np.column_stack([np.interp(t, twin.times, twin.outputs[n]) for n in names])
-    return SiteDeviation(site, axes, t, np.linalg.norm(p - p0, axis=1))
+    return SiteDeviation(site, axes, t, np.linalg.norm(p - p0, axis=1), frame)
 
 
-def write_site_deviation_csv(dev: SiteDeviation, path: str | Path) -> Path:
-    """One row per moving coordinate: the `DeviationStatistics` fields [m]; written atomically."""
+def write_site_deviation_csv(devs: SiteDeviation | Sequence[SiteDeviation], path: str | Path) -> Path:
+    """One row per moving coordinate of each deviation (the world's, then a floating base's frame): the
+    `DeviationStatistics` fields [m]; written atomically."""
     buf = io.StringIO()
     fields = ["output", *DeviationStatistics.__dataclass_fields__]
     w = csv.DictWriter(buf, fieldnames=fields)
     w.writeheader()
-    for name, s in dev.axes.items():
-        w.writerow({"output": name, **{k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in asdict(s).items()}})
+    for dev in [devs] if isinstance(devs, SiteDeviation) else devs:
+        for name, s in dev.axes.items():
+            w.writerow(
+                {"output": name, **{k: (f"{v:.6g}" if isinstance(v, float) else v) for k, v in asdict(s).items()}}
+            )
     atomic_write_text(path, buf.getvalue())
     return Path(path)

@@ -14,7 +14,7 @@ import numpy as np
 
 from clearance.results import SimulationResult, atomic_write_text
 
-__all__ = ["JointSummary", "joint_summary", "rms_deviation", "summarise", "write_summary_csv"]
+__all__ = ["JointSummary", "joint_summary", "rms_deviation", "summarise", "summary_of_series", "write_summary_csv"]
 
 
 @dataclass(frozen=True)
@@ -108,13 +108,41 @@ def joint_summary(
         The joint's `JointSummary`.
     """
     jr = result.joints[joint]
-    f = jr.force_magnitude
-    contact = jr.penetration > 0
+    return summary_of_series(
+        joint,
+        result.times,
+        jr.penetration,
+        jr.force_magnitude,
+        deviation=deviation,
+        startup=startup,
+        steady_deviation=steady_deviation,
+    )
+
+
+def summary_of_series(
+    joint: str,
+    times: np.ndarray,
+    penetration: np.ndarray,
+    force: np.ndarray,
+    *,
+    deviation: float = float("nan"),
+    startup: float = 0.0,
+    steady_deviation: float = float("nan"),
+) -> JointSummary:
+    """`joint_summary` of a joint's series: a run's rows, or every step of a run whose rows are thinned.
+
+    Args:
+        joint: the joint's name.
+        times: (n,) [s]. penetration: (n,) |e| - c [m]. force: (n,) contact-force magnitude [N].
+        deviation, startup, steady_deviation: as `joint_summary`'s.
+    """
+    f = force
+    contact = penetration > 0
     onsets = int(np.count_nonzero(contact[1:] & ~contact[:-1]) + (1 if len(contact) and contact[0] else 0))
     k = int(np.argmax(f)) if len(f) else 0
     nan = float("nan")
     s_peak, s_p95, s_impacts, s_fraction, s_pen = nan, nan, -1, nan, nan
-    k0 = int(np.searchsorted(result.times, startup)) if startup > 0 else len(f)
+    k0 = int(np.searchsorted(times, startup)) if startup > 0 else len(f)
     if startup > 0 and k0 < len(f) - 1:
         fs, cs = f[k0:], contact[k0:]
         before = bool(contact[k0 - 1]) if k0 > 0 else False  # an onset needs the sample before it
@@ -122,15 +150,15 @@ def joint_summary(
         s_p95 = float(np.percentile(fs[cs], 95)) if cs.any() else 0.0
         s_impacts = int(np.count_nonzero(cs[1:] & ~cs[:-1]) + (1 if cs[0] and not before else 0))
         s_fraction = float(cs.mean())
-        s_pen = float(jr.penetration[k0:].max())
+        s_pen = float(penetration[k0:].max())
     return JointSummary(
         joint=joint,
         peak_force=float(f.max()) if len(f) else 0.0,
         p95_force=float(np.percentile(f[contact], 95)) if contact.any() else 0.0,
-        peak_force_time=float(result.times[k]) if len(f) else float("nan"),
+        peak_force_time=float(times[k]) if len(f) else float("nan"),
         impacts=onsets,
         contact_fraction=float(contact.mean()) if len(contact) else 0.0,
-        max_penetration=float(jr.penetration.max()) if len(f) else 0.0,
+        max_penetration=float(penetration.max()) if len(f) else 0.0,
         output_rms_deviation=deviation,
         startup_window=startup,
         steady_peak_force=s_peak,

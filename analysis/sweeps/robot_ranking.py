@@ -327,6 +327,7 @@ def robot_ranking_markdown(ranking: RobotRanking) -> str:
         "|---:|---|---:|---|---:|---:|---:|",
     ]
     lines += _score_rows(ranking.overall, 1e6)
+    lines += _resolution(ranking.overall, 1e6, "µm")
     for kind, r in ranking.by_kind.items():
         unit, scale = _score_label(kind)
         size = ranking.sizes[kind]
@@ -339,6 +340,7 @@ def robot_ranking_markdown(ranking: RobotRanking) -> str:
             "|---:|---|---:|---|---:|---:|---:|",
         ]
         lines += _score_rows(r, scale)
+        lines += _resolution(r, scale, unit)
     lines += [
         "",
         "### Per cell",
@@ -354,6 +356,30 @@ def robot_ranking_markdown(ranking: RobotRanking) -> str:
     for p, e in ranking.failed:
         lines.append(f"\nfailed: {p}: {e}")
     return "\n".join(lines) + "\n"
+
+
+RESOLVED = 0.95
+"""A candidate is told apart from the next where it exceeds it with this probability (`rank_joints`'s)."""
+
+
+def _resolution(r: CriticalityRanking, scale: float, unit: str) -> list[str]:
+    """A line under a ranking table where its order is not a ranking: adjacent candidates not told apart at
+    `RESOLVED`, the widest interval and what would narrow them."""
+    pairs = [s for s in r.scores if np.isfinite(s.confidence_above_next)]
+    unresolved = [s for s in pairs if s.confidence_above_next < RESOLVED]
+    if not unresolved:
+        return []
+    widest = max(r.scores, key=lambda s: s.ci_high - s.ci_low)
+    cells = max(s.cells for s in r.scores)
+    periods = min((c.cycles for c in r.cells), default=0)
+    return [
+        "",
+        f"**Not a ranking:** {len(unresolved)} of {len(pairs)} candidates are not told apart from the next at "
+        f"{RESOLVED:.0%} (the widest interval, {widest.joint}'s, spans {(widest.ci_high - widest.ci_low) * scale:.3g} "
+        f"{unit} from {cells} grid cell{'s' * (cells > 1)} of {periods} or more whole periods each): the order "
+        "above is the means' only. More cells (--amplitudes, --frequencies-hz) or longer runs (--duration-ms) "
+        "narrow the intervals.",
+    ]
 
 
 def _score_rows(r: CriticalityRanking, scale: float) -> list[str]:

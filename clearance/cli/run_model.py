@@ -1,34 +1,38 @@
 """``clearance run --model DIR``: run what ``clearance retrofit`` wrote, and its unmodified twin.
 
     clearance run --model DIR [--control CTRL.csv | --sine-amplitude A --sine-frequency-hz F]
-                  [--duration-ms T] [--site NAME] [--out OUT] [--rerun RUN.rrd]
+                  [--duration-ms T] [--startup-ms S] [--output-every-us U] [--site NAME] [--out OUT]
+                  [--rerun RUN.rrd]
 
 Both models run at the retrofit's time step (``DIR/retrofit.json``) from their first
 keyframe under the same controls: a control file (a header ``time_s,<actuator>,...`` naming
 every actuator once, ``#k`` for an unnamed one; linear interpolation, held beyond its rows)
-or the sinusoid the retrofit was sized from (default). The run's arrays go to
-``result.npz/json``, the twin's to ``ideal.npz/json``, with ``summary.csv`` (contact
-statistics per hinge; for a backlash retrofit ``backlash_summary.csv``: per hinge the angle's
-range in the band, the impacts at its ends and the peak stop torque), ``site_deviation.csv``
-(of ``--site``, by default the named body deepest below the retrofitted hinges: the end
-effector) and ``report.md`` with its
-figures (`clearance.analysis.figures.model_report`); ``--rerun`` also records the bodies of
-both models moving in 3-D with the orbits beside them (`clearance.analysis.recording.model_rerun`).
+or the sinusoid the retrofit was sized from (default). The journals start centred, so their
+first drop falls in a start-up window (``--startup-ms``; by default 0.25 s or one period of
+the sinusoid, the longer) and the steady-state statistics start after it. The run's arrays go
+to ``result.npz/json``, the twin's to ``ideal.npz/json`` (rows thinned beyond `OUTPUT_BUDGET`
+bytes per run; ``--output-every-us``), with ``summary.csv`` (contact statistics per hinge from
+every step, over the whole run and the steady state; for a backlash retrofit
+``backlash_summary.csv``: per hinge the angle's range in the band, the impacts at its ends and
+the peak stop torque), ``site_deviation.csv`` (of ``--site``, by default the named body deepest
+below the retrofitted hinges: the end effector; also in its floating base's frame where the
+model has one) and ``report.md`` with its figures (`clearance.analysis.figures.model_report`),
+which also says whether the deviation is the play's or chaos (the twin against itself nudged
+by rounding); ``--rerun`` also records the bodies of both models moving in 3-D with the orbits
+beside them (`clearance.analysis.recording.model_rerun`). The run itself is
+`clearance.cli.run_model_output`.
 """
 
 from __future__ import annotations
 
 import argparse
-import math
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from clearance.cli.limits import check_steps
 from clearance.cli.options import bounded, positive, si
-from clearance.cli.outputs import writing_outputs
-from clearance.result_units import result_units
-from clearance.units import format_quantity as q
+from clearance.cli.run_model_output import run_and_write
 
 if TYPE_CHECKING:
     from clearance.retrofit.drive import Drive
@@ -52,9 +56,17 @@ SCENARIO_DESTS = {
 """Options of a mechanism's run that a retrofitted model's run does not take (dest -> flag)."""
 
 _MODEL_ONLY = {"control": "--control", "sine_amplitude": "--sine-amplitude", "sine_frequency_hz": "--sine-frequency-hz"}
-_MODEL_ONLY["site"] = "--site"
+_MODEL_ONLY |= {"site": "--site", "startup_ms": "--startup-ms", "output_every_us": "--output-every-us"}
 
 DEFAULT_DURATION_MS = 1000.0
+
+OUTPUT_BUDGET = 20e6
+"""Bytes of arrays a run keeps by default [B]: beyond it its rows are thinned (a run and its twin stay
+under 50 MB together, figures included); peaks and contact statistics come from every step anyway."""
+
+DEFAULT_STARTUP_MS = 250.0
+"""The start-up window's floor [ms] (as `clearance rank --model` skips); a sinusoid's run skips one of its
+periods where that is longer."""
 
 
 def add_model_args(r: argparse.ArgumentParser) -> None:
@@ -67,7 +79,8 @@ def add_model_args(r: argparse.ArgumentParser) -> None:
         default=None,
         metavar="DIR",
         help="a folder written by clearance retrofit (or its model.xml): run it and its unmodified twin at the "
-        f"retrofit's time step (default duration {DEFAULT_DURATION_MS:g} ms)",
+        f"retrofit's time step (default duration {DEFAULT_DURATION_MS:g} ms, or twice the start-up window where that "
+        "is longer: 2 s under the default 1 Hz sinusoid)",
     )
     g.add_argument(
         "--control",
@@ -88,6 +101,21 @@ def add_model_args(r: argparse.ArgumentParser) -> None:
         type=positive(float, "--sine-frequency-hz"),
         default=None,
         help="frequency of that sinusoid [Hz] (default 1)",
+    )
+    g.add_argument(
+        "--startup-ms",
+        type=bounded(float, "--startup-ms", 0.0),
+        default=None,
+        help=f"start-up window [ms]: the steady-state statistics start after it (default {DEFAULT_STARTUP_MS:g} ms or "
+        "one period of the sinusoid, whichever is longer; the journals start centred, so their first drop is in it)",
+    )
+    g.add_argument(
+        "--output-every-us",
+        type=bounded(float, "--output-every-us", 0.0),
+        default=None,
+        help="interval of the rows kept in result.npz and ideal.npz [us] (default: every step up to "
+        f"{OUTPUT_BUDGET / 1e6:g} MB of arrays per run, thinned beyond; peaks and contact statistics always from every "
+        "step; 0: every step)",
     )
     g.add_argument(
         "--site",
@@ -172,96 +200,37 @@ def model_command(args: argparse.Namespace) -> int:
         drive = SineControl(amplitude, 1.0 if args.sine_frequency_hz is None else args.sine_frequency_hz)
     sites = [args.site] if args.site else _default_site(loaded)
     loaded.check_sites(sites)
-    duration = si(args.duration_ms if args.duration_ms else DEFAULT_DURATION_MS, "ms")
-    source = f"--duration-ms {args.duration_ms:g}" if args.duration_ms else f"the default {DEFAULT_DURATION_MS:g} ms"
+    startup = startup_window(args.startup_ms, drive)
+    # by default the run leaves a steady state as long as its start-up window
+    duration = si(args.duration_ms, "ms") if args.duration_ms else max(si(DEFAULT_DURATION_MS, "ms"), 2 * startup)
+    source = f"--duration-ms {args.duration_ms:g}" if args.duration_ms else f"the default {duration * 1e3:g} ms"
     check_steps(duration, loaded.manifest.timestep, source)
+    if args.startup_ms is not None and startup >= duration:
+        raise ValueError(
+            f"--startup-ms {args.startup_ms:g}: the start-up window must be shorter than the run "
+            f"({duration * 1e3:g} ms); lower it or give a longer --duration-ms"
+        )
+    interval = output_interval(args.output_every_us, loaded, duration, sites)
     with folder_lock(out):
-        return _run(args, loaded, drive, sites, duration, out)
+        return run_and_write(args, loaded, drive, sites, duration, out, startup=startup, interval=interval)
 
 
-def _run(
-    args: argparse.Namespace, loaded: Retrofitted, drive: Drive, sites: list[str], duration: float, out: Path
-) -> int:
-    from clearance.analysis.figures.model_report import write_model_report
-    from clearance.analysis.metrics.backlash_impacts import backlash_summaries, write_backlash_csv
-    from clearance.analysis.metrics.site_deviation import site_deviation, write_site_deviation_csv
-    from clearance.analysis.metrics.summary import summarise, write_summary_csv
+def startup_window(startup_ms: float | None, drive: Drive) -> float:
+    """The start-up window [s]: ``--startup-ms``, else `DEFAULT_STARTUP_MS` or one sinusoid period, the longer."""
     from clearance.retrofit import SineControl
-    from clearance.run.retrofitted import simulate_retrofitted
-    from clearance.run.simulation import SimulationError
 
+    if startup_ms is not None:
+        return si(startup_ms, "ms")
+    period = 1.0 / drive.frequency if isinstance(drive, SineControl) else 0.0
+    return max(si(DEFAULT_STARTUP_MS, "ms"), period)
+
+
+def output_interval(every_us: float | None, loaded: Retrofitted, duration: float, sites: list[str]) -> float | None:
+    """The rows' interval [s]: ``--output-every-us`` (0: every step), else every step within `OUTPUT_BUDGET`."""
+    from clearance.run.retrofit_rows import default_output_interval, row_bytes
+
+    if every_us is not None:
+        return None if every_us == 0 else max(si(every_us, "us"), loaded.manifest.timestep)
     m = loaded.manifest
-    play = f"radial play at {[h.name for h in m.hinges]}" if m.hinges else ""
-    if m.backlash:
-        arcmin = ", ".join(f"{b.name} +-{b.half_width * 10800 / math.pi:.4g}'" for b in m.backlash)
-        play = f"{play}; " * bool(play) + f"backlash at {arcmin}"
-    kind = "" if not m.hinges else ", exact contact" if m.contact_mode == "exact" else f", {m.contact_mode} ring"
-    print(
-        f"{loaded.folder}: {play}, {q(duration, 's', digits=4)} at h = {q(m.timestep, 's')} (the model's own "
-        f"{q(m.original_timestep, 's')}){kind}"
-    )
-    failed = None
-    try:
-        result = simulate_retrofitted(loaded, drive, duration, sites=sites)
-    except SimulationError as err:
-        failed, partial = err, err.partial
-        if partial is None:
-            print(f"error: {failed}", file=sys.stderr)
-            return 2
-        result = partial
-    try:
-        twin = simulate_retrofitted(loaded, drive, duration, twin=True, sites=sites)
-    except SimulationError as err:
-        print(f"error: the unmodified twin, needed for the deviations: {err}", file=sys.stderr)
-        return 2
-    for run in (result, twin):  # every array's and number's unit, in the files themselves
-        run.metadata["units"] = result_units(run.arrays())
-    stopped = None if failed is None else str(failed)
-    if stopped is not None:
-        result.metadata["stopped"] = stopped
-    rows = summarise(result, None)
-    backlash = backlash_summaries(result)
-    deviation = site_deviation(result, twin, sites[0]) if sites and len(result.times) >= 3 else None
-    # contacts longer than 5 % of the sinusoid's period (of the run, under a control file) are continuous
-    period = 1.0 / drive.frequency if isinstance(drive, SineControl) else duration
-    with writing_outputs(out, args.rerun) as (stage, recording):  # all of them, or none
-        result.save(stage / "result")
-        twin.save(stage / "ideal")
-        write_summary_csv(rows, stage / "summary.csv")
-        if backlash:
-            write_backlash_csv(backlash, stage / "backlash_summary.csv")
-        if deviation is not None:
-            write_site_deviation_csv(deviation, stage / "site_deviation.csv")
-        write_model_report(stage, result, twin, rows, deviation, continuous_after=0.05 * period, stopped=stopped)
-        if recording is not None:
-            from clearance.analysis.recording.model_rerun import record_model_run
-
-            record_model_run(result, twin, loaded.model, loaded.twin, recording, deviation=deviation)
-    rrd = None if not args.rerun else Path(args.rerun).resolve()
-    for r in rows:
-        if not r.max_penetration > 0:
-            print(f"  {r.joint}: no contact (the journal stayed {q(-r.max_penetration, 'm')} from its ring)")
-            continue
-        print(
-            f"  {r.joint}, whole run: peak force {q(r.peak_force, 'N', digits=4)} at {q(r.peak_force_time, 's')}, "
-            f"p95 {q(r.p95_force, 'N', digits=4)}, {r.impacts} impacts, max penetration {q(r.max_penetration, 'm')}"
-        )
-    for b in backlash:
-        print(
-            f"  {b.hinge}: backlash angle in [{b.min_angle * 10800 / math.pi:.4g}, {b.max_angle * 10800 / math.pi:.4g}]"
-            f"' (band +-{b.half_width * 10800 / math.pi:.4g}'), {b.impacts} impacts at its ends ({b.impacts_upper} at "
-            f"+b, {b.impacts_lower} at -b), peak stop torque {q(b.peak_torque, 'N m', digits=4)} at "
-            f"{q(b.peak_torque_time, 's')}"
-        )
-    if deviation is not None:
-        axes = ", ".join(f"{k.rsplit('/', 1)[1]} {q(s.rms_deviation, 'm')}" for k, s in deviation.axes.items())
-        print(
-            f"  {deviation.site}: deviation from the twin up to {q(deviation.max_distance, 'm')} over the whole run; "
-            f"RMS {axes}" + ("" if args.site else " (the end effector by default: --site to choose another point)")
-        )
-    rate = float(f"{result.metadata['steps_per_second']:.3g}")
-    print(f"  {rate:,.0f} steps/s; wrote {out}/" + ("" if rrd is None else f" and {rrd}"))
-    if failed is not None:
-        print(f"error: {failed}", file=sys.stderr)
-        return 2
-    return 0
+    per_row = row_bytes(loaded.model, len(m.hinges), len(sites), len(m.backlash))
+    return default_output_interval(loaded.model, duration, per_row, OUTPUT_BUDGET)

@@ -26,7 +26,7 @@ from clearance.results import SimulationResult
 from clearance.retrofit.play import Backlash, RadialPlay, RetrofitError, RetrofitOptions, SineControl
 from clearance.run.retrofitted import Retrofitted, point_of, retrofitted, simulate_retrofitted
 
-__all__ = ["PLAYS", "PlayAtHinge", "actuated_hinges", "check_candidates", "end_effector"]
+__all__ = ["floating_base", "PLAYS", "PlayAtHinge", "actuated_hinges", "check_candidates", "end_effector"]
 
 PLAYS = ("radial", "backlash")
 """The kinds of play a candidate hinge is given."""
@@ -44,14 +44,21 @@ def actuated_hinges(model: mujoco.MjModel) -> list[str]:
     ]
 
 
-def end_effector(model: mujoco.MjModel, hinges: Sequence[str]) -> str:
+def end_effector(model: mujoco.MjModel, hinges: Sequence[str], *, avoid: Sequence[str] = ()) -> str:
     """The default point whose deviation is scored: the named body deepest below the hinges
-    (the most ancestors; the last in the model's order among equals).
+    (the most ancestors; the last in the model's order among equals), not below a hinge of ``avoid``
+    that is itself below them (hinges left out of the retrofit: a refused hinge's link may move on its own).
 
     Raises:
         RetrofitError: no named body moves with the hinges.
     """
     roots = {int(model.jnt_bodyid[model.joint(h).id]) for h in hinges}
+    above = set()  # the hinges' bodies and their ancestors: an avoided hinge there moves every candidate alike
+    for r in roots:
+        while r:
+            above.add(r)
+            r = int(model.body_parentid[r])
+    skipped = {int(model.jnt_bodyid[model.joint(h).id]) for h in avoid} - above
     best, depth = "", -1
     for b in range(1, model.nbody):
         chain, k = [], b
@@ -59,11 +66,33 @@ def end_effector(model: mujoco.MjModel, hinges: Sequence[str]) -> str:
             chain.append(k)
             k = int(model.body_parentid[k])
         name = model.body(b).name
-        if name and roots & set(chain) and len(chain) >= depth:
+        if name and roots & set(chain) and not skipped & set(chain) and len(chain) >= depth:
             best, depth = name, len(chain)
     if not best:
         raise RetrofitError(f"no named body moves with the hinges {list(hinges)}: name a site or body with --site")
     return best
+
+
+def floating_base(model: mujoco.MjModel, point: str) -> str | None:
+    """The floating base that carries ``point`` (a site or a body): the top body of its chain (a child of
+    the world) where that body has a free joint or a slide (a mobile or planar base: gymnasium's runners'
+    rootx/rootz, Fetch's base slides); None for a base fixed to the world (an arm whose first joint is a
+    hinge). Its name, or ``#id``.
+
+    Raises:
+        KeyError: ``point`` is neither a site nor a body of ``model``.
+    """
+    sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, point)
+    body = int(model.site_bodyid[sid]) if sid >= 0 else mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, point)
+    if body < 0:
+        raise KeyError(point)
+    while body and model.body_parentid[body]:
+        body = int(model.body_parentid[body])
+    first, count = int(model.body_jntadr[body]), int(model.body_jntnum[body])
+    kinds = {int(model.jnt_type[j]) for j in range(first, first + count)}
+    if not kinds & {int(mujoco.mjtJoint.mjJNT_FREE), int(mujoco.mjtJoint.mjJNT_SLIDE)}:
+        return None
+    return mujoco.mj_id2name(model, mujoco.mjtObj.mjOBJ_BODY, body) or f"#{body}"
 
 
 def check_candidates(model: mujoco.MjModel, joints: Sequence[str], plays: Sequence[str], where: str) -> None:

@@ -34,15 +34,15 @@ from pathlib import Path
 import mujoco
 import numpy as np
 
-from clearance.contact_plugin.attributes import sensor_offsets
-from clearance.results import JointResult, SimulationResult
+from clearance.results import SimulationResult
 from clearance.retrofit.drive import Drive, drive_controls
-from clearance.retrofit.loop import connect_residual
-from clearance.retrofit.manifest import BacklashRecord, HingeRecord, RetrofitManifest, read_manifest
+from clearance.retrofit.manifest import HingeRecord, RetrofitManifest, read_manifest
 from clearance.retrofit.motion import initial_data, scalar_coordinates
 from clearance.retrofit.play import RetrofitError
-from clearance.run.backlash_readout import BacklashReader, add_backlash_sensors
-from clearance.run.readout import _exact_contact_force
+from clearance.run.backlash_readout import add_backlash_sensors
+from clearance.run.retrofit_rows import RowReader
+from clearance.run.retrofit_rows import point_of as point_of
+from clearance.run.retrofit_rows import site_output_names as site_output_names
 from clearance.run.simulation import SimulationError, StepFailure, model_stepper
 from clearance.version import __version__
 
@@ -86,17 +86,6 @@ class Retrofitted:
                         f"site {name!r} does not exist in {self.folder / label}: name a site "
                         f"({', '.join(have) or 'it has none'}) or a body"
                     ) from None
-
-
-def point_of(model: mujoco.MjModel, name: str) -> tuple[str, int]:
-    """('site', id) of the site ``name``, else ('body', id) of the body (its origin); KeyError if neither."""
-    sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, name)
-    if sid >= 0:
-        return "site", int(sid)
-    bid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, name)
-    if bid >= 0:
-        return "body", int(bid)
-    raise KeyError(name)
 
 
 def load_retrofitted(path: str | os.PathLike[str]) -> Retrofitted:
@@ -144,11 +133,6 @@ def retrofitted(
     return Retrofitted(Path(folder), manifest, model, twin)
 
 
-def site_output_names(site: str) -> list[str]:
-    """Output names of a site's world position: ``site/<name>/x``, ``/y``, ``/z``."""
-    return [f"site/{site}/{a}" for a in "xyz"]
-
-
 def simulate_retrofitted(
     loaded: Retrofitted,
     drive: Drive,
@@ -160,6 +144,7 @@ def simulate_retrofitted(
     progress: Callable[[float], None] | None = None,
     chunk_steps: int = 50_000,
     perturbation: float = 0.0,
+    every_step: Callable[[np.ndarray, dict[str, tuple[np.ndarray, np.ndarray]]], None] | None = None,
 ) -> SimulationResult:
     """Run the retrofitted model (or, with ``twin``, the unmodified one) from its first keyframe.
 
@@ -174,6 +159,9 @@ def simulate_retrofitted(
         chunk_steps: steps per `mujoco.rollout` call.
         perturbation: added to every hinge and slide coordinate of the first keyframe [rad or m]
             (`clearance.run.sensitivity`: a rounding-size nudge that shows chaos); 0: none.
+        every_step: called after each chunk with the times of every step kept (rows or not) and,
+            per hinge with radial play, its penetration |e| - c [m] and contact-force magnitude [N]
+            at each: full-rate peaks and statistics where the rows are thinned.
 
     Raises:
         ValueError: a bad duration or interval; `RetrofitError` an unknown site (before any work).
@@ -193,7 +181,7 @@ def simulate_retrofitted(
     data = initial_data(model)
     if perturbation:
         data.qpos[scalar_coordinates(model)] += perturbation
-    reader = _Reader(model, hinges, sites, backlash)
+    reader = RowReader(model, hinges, sites, backlash)
     step = model_stepper(model, data)
     parts: list[SimulationResult] = []
     qpos_before = data.qpos.copy()
@@ -217,6 +205,9 @@ def simulate_retrofitted(
             bad = (k, None, failure)
         # only the rows kept are read (poses need a kinematics pass each); the bounds saw every row
         rows = np.arange((-done) % every, k if bad is None else bad[0], every)
+        if every_step is not None:
+            stop = k if bad is None else bad[0]
+            every_step(times[:stop], reader.full_rate(sens[:stop]))
         parts.append(reader.read(times[rows], sens[rows], q[rows], v[rows]))
         if bad is not None:
             idx, joint, why = bad
@@ -273,100 +264,6 @@ def _first_bad(
     if first_nan < n:
         return first_nan, None, "the state became non-finite (NaN or Inf)"
     return None
-
-
-class _Reader:
-    """Sensor and position rows -> a `SimulationResult` chunk."""
-
-    def __init__(
-        self,
-        model: mujoco.MjModel,
-        hinges: Sequence[HingeRecord],
-        sites: Sequence[str],
-        backlash: Sequence[BacklashRecord] = (),
-    ) -> None:
-        self.model, self.hinges, self.sites = model, hinges, list(sites)
-        self.backlash = BacklashReader(model, backlash)
-        self.data = mujoco.MjData(model)
-
-        def sensor(name: str) -> slice:
-            s = model.sensor(name)
-            return slice(int(s.adr[0]), int(s.adr[0] + s.dim[0]))
-
-        def jid(kind: mujoco.mjtObj, name: str) -> int:
-            return int(mujoco.mj_name2id(model, kind, name))
-
-        self.ecc = {hr.name: sensor(hr.eccentricity_sensor) for hr in hinges}
-        self.exact = {hr.name: sensor_offsets(model, hr.force_sensor) for hr in hinges if hr.segments == 0}
-        self.force = {hr.name: sensor(hr.force_sensor) for hr in hinges if hr.segments > 0}
-        self.bearing_site = {hr.name: jid(mujoco.mjtObj.mjOBJ_SITE, hr.bearing_site) for hr in hinges}
-        self.slide_dof = {
-            hr.name: [int(model.jnt_dofadr[jid(mujoco.mjtObj.mjOBJ_JOINT, s)]) for s in hr.slides] for hr in hinges
-        }
-        self.points = [point_of(model, s) for s in self.sites]
-        self.connects = [
-            e for e in range(model.neq) if model.eq_type[e] == mujoco.mjtEq.mjEQ_CONNECT and model.eq_active0[e]
-        ]
-
-    def eccentricity(self, sens: np.ndarray, hinge: HingeRecord) -> tuple[np.ndarray, np.ndarray]:
-        """(eccentricity (n, 2) [m], penetration |e| - c (n,) [m]) of a hinge from sensor rows."""
-        e = sens[:, self.ecc[hinge.name]][:, :2].copy()
-        return e, np.hypot(e[:, 0], e[:, 1]) - hinge.radial_clearance
-
-    def penetrations(self, sens: np.ndarray) -> dict[str, np.ndarray]:
-        """Hinge -> its penetration (n,) [m] over sensor rows."""
-        return {hr.name: self.eccentricity(sens, hr)[1] for hr in self.hinges}
-
-    def read(self, times: np.ndarray, sens: np.ndarray, q: np.ndarray, v: np.ndarray) -> SimulationResult:
-        model, data = self.model, self.data
-        n = len(times)
-        poses = np.zeros((n, model.nbody, 7))
-        site_pos = np.zeros((n, len(self.points), 3))
-        bearing_rot = {name: np.zeros((n, 3, 3)) for name in self.bearing_site}
-        closure = np.zeros(n)
-        for i in range(n):
-            data.qpos[:] = q[i]
-            if not np.isfinite(q[i]).all():
-                poses[i:] = np.nan
-                site_pos[i:] = np.nan
-                closure[i:] = np.nan
-                break
-            mujoco.mj_kinematics(model, data)
-            closure[i] = max((connect_residual(model, data, e) for e in self.connects), default=0.0)
-            poses[i, :, :3] = data.xpos
-            poses[i, :, 3:] = data.xquat
-            for k, (kind, pid) in enumerate(self.points):
-                site_pos[i, k] = data.site_xpos[pid] if kind == "site" else data.xpos[pid]
-            for name, sid in self.bearing_site.items():
-                bearing_rot[name][i] = data.site_xmat[sid].reshape(3, 3)
-        joints = {}
-        for hr in self.hinges:
-            e, pen = self.eccentricity(sens, hr)
-            rate = v[:, self.slide_dof[hr.name]]
-            if hr.name in self.exact:  # the plugin's normal and tangential force, in the bearing frame
-                f = _exact_contact_force(sens, self.exact[hr.name], e)
-            else:
-                # the sensor names only the journal geom, so it reads the force the journal exerts on
-                # the ring: the force on the journal is its opposite
-                f_world = -sens[:, self.force[hr.name]]
-                f = np.einsum("nji,nj->ni", bearing_rot[hr.name], f_world)[:, :2]
-            joints[hr.name] = JointResult(e, rate, pen, f)
-        outputs = {}
-        for k, s in enumerate(self.sites):
-            for a, name in enumerate(site_output_names(s)):
-                outputs[name] = site_pos[:, k, a].copy()
-        outputs.update(self.backlash.read(sens, q))
-        return SimulationResult(
-            times=np.asarray(times, dtype=float),
-            outputs=outputs,
-            joints=joints,
-            drive_angle=np.zeros((n, 0)),
-            drive_speed=np.zeros((n, 0)),
-            drive_torque=np.zeros((n, 0)),
-            link_poses=np.zeros((n, 0, 3)),
-            closure_violation=closure,
-            body_poses=poses,
-        )
 
 
 def _finish(
