@@ -1,6 +1,6 @@
 """Every retrofit checked on a fixed, versioned list of third-party robots.
 
-    pip install -e '.[corpus]'   (robosuite 1.5.2, gymnasium-robotics 1.4.2; gymnasium comes with the test extra)
+    pip install --no-deps robosuite==1.5.2 gymnasium-robotics==1.4.2   (the extra "corpus"; --no-deps keeps numpy)
     python benchmarks/retrofit_corpus.py [--models panda,ur5e] [--fresh] [--table-only]
 
 For each model of `CORPUS` and each operation (radial play and backlash with the exact contact or
@@ -73,7 +73,7 @@ def model_path(package: str, inside: str) -> Path:
     """The model file inside an installed package (found without importing it)."""
     spec = importlib.util.find_spec(package)
     if spec is None or not spec.submodule_search_locations:
-        raise SystemExit(f"{package} is not installed: pip install -e '.[corpus]'")
+        raise SystemExit(f"{package} is not installed: pip install --no-deps robosuite==1.5.2 gymnasium-robotics==1.4.2")
     return Path(next(iter(spec.submodule_search_locations))) / inside
 
 
