@@ -73,7 +73,9 @@ def model_path(package: str, inside: str) -> Path:
     """The model file inside an installed package (found without importing it)."""
     spec = importlib.util.find_spec(package)
     if spec is None or not spec.submodule_search_locations:
-        raise SystemExit(f"{package} is not installed: pip install --no-deps robosuite==1.5.2 gymnasium-robotics==1.4.2")
+        raise SystemExit(
+            f"{package} is not installed: pip install --no-deps robosuite==1.5.2 gymnasium-robotics==1.4.2"
+        )
     return Path(next(iter(spec.submodule_search_locations))) / inside
 
 
