@@ -53,6 +53,7 @@ __all__ = [
     "StepStop",
     "exact_impact",
     "fit_step_stop",
+    "fit_to_impact",
     "largest_step",
     "smallest_band",
     "step_impact",
@@ -83,7 +84,7 @@ class ExactImpact:
     Attributes:
         rebound: opening speed after the impact over the closing speed [-].
         impulse: the stop's impulse over the impact divided by J v [-] (1 + rebound for a free impact).
-        timestep: the fine step it ran at [s].
+        timestep: the fine step it ran at [s] (0: the law's own impact, integrated without a step).
     """
 
     rebound: float
@@ -268,10 +269,30 @@ def fit_step_stop(law: MeshLaw, *, timestep: float, integrator: int, inertia: fl
     Raises:
         ValueError: bad arguments. RuntimeError: a scene did not separate.
     """
+    exact = exact_impact(law, inertia=inertia, speed=speed)
+    return fit_to_impact(exact, timestep=timestep, integrator=integrator)
+
+
+def fit_to_impact(exact: ExactImpact, *, timestep: float, integrator: int) -> StepStop:
+    """Fit the step-limited stop's damping ratio to an exact impact's rebound and impulse per impact.
+
+    `fit_step_stop` for the gear mesh; radial play fits its bearing's law the same way
+    (`clearance.retrofit.radial_stop`).
+
+    Args:
+        exact: the exact stop's impact (rebound, impulse over the inertia times the closing speed).
+        timestep: the robot's step h [s].
+        integrator: the model's integrator (``mjtIntegrator`` value).
+
+    Returns:
+        The fitted stop: ω̂ = `step_omega`, ζ, its impacts at `PHASES` and its worst penetration per speed.
+
+    Raises:
+        ValueError: bad arguments. RuntimeError: a scene did not separate.
+    """
     from scipy.optimize import least_squares  # on first use
 
     h = positive("timestep", timestep, "s")
-    exact = exact_impact(law, inertia=inertia, speed=speed)
     target = np.array([exact.rebound, exact.impulse])
 
     def impacts(x: float) -> list[StepImpact]:
