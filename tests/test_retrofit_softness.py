@@ -153,22 +153,35 @@ def test_refusals_carry_their_listed_reason():
           <worldbody>
             <body name="base">
               <joint name="slide" type="slide"/>
+              <joint name="lift" type="slide" axis="1 0 0"/>
               <joint name="turn" type="hinge"/>
               <geom type="box" size="0.1 0.1 0.1" mass="1"/>
               <body name="tip" pos="0.3 0 0">
                 <joint name="light" type="hinge" axis="0 0 1"/>
                 <geom type="sphere" size="0.01" mass="1e-6"/>
               </body>
+              <body name="wrist" pos="0 0.3 0">
+                <joint name="roll" type="hinge" axis="1 0 0"/>
+                <joint name="pitch" type="hinge" axis="0 1 0"/>
+                <geom type="sphere" size="0.02" mass="0.1"/>
+              </body>
             </body>
           </worldbody>
           <tendon><fixed name="couple"><joint joint="light" coef="1"/></fixed></tendon>
-          <actuator><motor joint="turn" ctrlrange="-1 1"/><motor tendon="couple" ctrlrange="-1 1"/></actuator>
+          <actuator>
+            <motor joint="turn" ctrlrange="-1 1"/><motor tendon="couple" ctrlrange="-1 1"/>
+            <motor joint="roll" ctrlrange="-1 1"/>
+          </actuator>
         </mujoco>
         """
     )
     cases = [
         (lambda: retrofit(spec, {"slide": RadialPlay()}), Refusal.NOT_A_HINGE, "slide"),
-        (lambda: retrofit(spec, {"turn": RadialPlay()}), Refusal.SHARED_BODY, "turn"),
+        (lambda: retrofit(spec, {"turn": RadialPlay()}), Refusal.FLOATING_BASE, "turn"),  # 2 slides, on the world
+        (lambda: add_backlash(spec, {"turn": Backlash.from_arcmin(5)}), Refusal.FLOATING_BASE, "turn"),
+        (lambda: retrofit(spec, {"roll": RadialPlay()}), Refusal.SHARED_BODY, "roll"),  # a compound joint
+        (lambda: add_backlash(spec, {"roll": Backlash.from_arcmin(5)}), Refusal.SHARED_BODY, "roll"),
+        (lambda: add_backlash(spec, {"pitch": Backlash.from_arcmin(5)}), Refusal.NO_ACTUATOR, "pitch"),
         (lambda: add_backlash(spec, {"light": Backlash.from_arcmin(5)}), Refusal.TENDON_DRIVEN, "light"),
         (
             lambda: retrofit(spec, {"light": RadialPlay()}, RetrofitOptions(contact_mode="exact", measure_speed=False)),
@@ -181,6 +194,6 @@ def test_refusals_carry_their_listed_reason():
             call()
         assert refusal_of(info.value) is reason, str(info.value)
         assert getattr(info.value, "hinge", hinge) == hinge
-    # the message of a refused hinge lists only hinges that can take play ('turn' shares its body)
+    # the message of a refused hinge lists only hinges that can take play ('turn', 'roll', 'pitch' share bodies)
     with pytest.raises(RetrofitError, match=r"that can: light\)"):
         retrofit(spec, {"turn": RadialPlay()})

@@ -22,10 +22,11 @@ normalised by the inertia it acts on, so on the light link alone it would let th
 the link far through its range; on the motor side it stops the drive where the twin's joint
 stopped, and the load stays within +-b of it.
 
-The motor body carries no mass (`MOTOR_MASS`, MuJoCo's floor requires some); the motor's
-inertia is its hinge's armature: the hinge's own armature moved to the motor side (the
-rotor's reflected inertia is what a joint armature models), or `MOTOR_ARMATURE_FRACTION` of
-the hinge's inertia at the reference pose where it has none, or the value the user gives.
+The motor body carries no mass (`MOTOR_MASS`, MuJoCo's floor requires some; in a model with a
+fluid, `motor_body_mass`); the motor's inertia is its hinge's armature: the hinge's own armature
+moved to the motor side (the rotor's reflected inertia is what a joint armature models), or
+`MOTOR_ARMATURE_FRACTION` of the hinge's inertia at the reference pose where it has none, or the
+value the user gives.
 """
 
 from __future__ import annotations
@@ -47,15 +48,17 @@ from clearance.retrofit.coordinates import extend_paired_keyframes, joint_index_
 from clearance.retrofit.elements import add_builtin_class
 from clearance.retrofit.masses import FROZEN_NOTE, check_masses, freeze_inertials
 from clearance.retrofit.play import PREFIX, Backlash, Refusal, RetrofitError
-from clearance.retrofit.selection import check_not_retrofitted, compile_model, joint_kind, model_label
+from clearance.retrofit.selection import check_not_retrofitted, compile_model, joint_kind, model_label, shared_body
 from clearance.retrofit.softness import keep_constraint_softness, softness_note
 
 __all__ = [
     "MOTOR_ARMATURE_FRACTION",
+    "FLUID_MOTOR_BOX",
     "MOTOR_MASS",
     "BacklashHinge",
     "BacklashRetrofit",
     "add_backlash",
+    "motor_body_mass",
     "motor_joint_name",
     "stop_plugin_name",
 ]
@@ -63,6 +66,15 @@ __all__ = [
 MOTOR_MASS = 1e-12
 """Mass and each principal inertia of a motor body [kg, kg m^2]: none to speak of (MuJoCo
 refuses a moving body without mass); the motor's inertia is its hinge's armature."""
+
+FLUID_MOTOR_BOX = 1e-4
+"""Side of the box MuJoCo's inertia-box fluid model sees in a motor body [m], in a model with a
+fluid (``<option density>`` or ``viscosity`` > 0). The model sizes a body's box from its principal
+inertias over its mass (side sqrt(6 I / m)) and applies the fluid's drag to every body with mass,
+so a motor body of `MOTOR_MASS` and inertia `MOTOR_MASS` is a 2.4 m box: in gymnasium's swimmer
+(density 4000) its drag moved the tail by 1.5 mm in 0.1 s against the twin, 5x the zero-play
+bound of a 0.1 arc-minute band. At 0.1 mm the drag is below 1e-5 of a link's a tenth of a metre
+across (force ~ side^2, torque ~ side^5)."""
 
 MOTOR_ARMATURE_FRACTION = 1e-4
 """Motor armature, where the hinge has none and none is given, as a fraction of the hinge's
@@ -78,6 +90,19 @@ _HINGE = mujoco.mjtJoint.mjJNT_HINGE
 _ACTUATOR_SENSORS = (mujoco.mjtSensor.mjSENS_JOINTACTFRC,)
 _STATE_SENSORS = (mujoco.mjtSensor.mjSENS_JOINTPOS, mujoco.mjtSensor.mjSENS_JOINTVEL)
 _TRN_JOINT = (int(mujoco.mjtTrn.mjTRN_JOINT), int(mujoco.mjtTrn.mjTRN_JOINTINPARENT))
+
+
+def motor_body_mass(twin: mujoco.MjModel) -> tuple[float, float]:
+    """A motor body's mass [kg] and each of its principal inertias [kg m^2] in ``twin``.
+
+    `MOTOR_MASS` for both, except in a model with a fluid: there MuJoCo's smallest inertia
+    (``mjMINVAL``) and the mass that makes the fluid model's box `FLUID_MOTOR_BOX` across
+    (6e-7 kg), so that the fluid does not drag on a body the twin does not have.
+    """
+    if twin.opt.density > 0 or twin.opt.viscosity > 0:
+        inertia = mujoco.mjMINVAL
+        return max(MOTOR_MASS, 6.0 * inertia / FLUID_MOTOR_BOX**2), inertia
+    return MOTOR_MASS, MOTOR_MASS
 
 
 def motor_joint_name(hinge: str) -> str:
@@ -133,6 +158,7 @@ class BacklashRetrofit:
         keyframes: keyframes extended (each motor angle and speed = its load's: the band centred).
         notes: remarks for a report.
         timestep: the model's time step [s] (the twin's, or lower where a calibrated stop needs it).
+        motor_mass: each motor body's mass [kg] (`motor_body_mass`).
     """
 
     spec: mujoco.MjSpec
@@ -143,6 +169,7 @@ class BacklashRetrofit:
     keyframes: int
     notes: list[str] = field(default_factory=list)
     timestep: float = 0.0
+    motor_mass: float = MOTOR_MASS
 
 
 def _actuator_label(model: mujoco.MjModel, k: int) -> str:
@@ -163,13 +190,6 @@ def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backl
             raise RetrofitError(
                 f"joint '{name}' is {joint_kind(twin, j)}: only a hinge can be given backlash",
                 reason=Refusal.NOT_A_HINGE,
-                hinge=name,
-            )
-        body = int(twin.jnt_bodyid[j])
-        if twin.body_jntnum[body] != 1:
-            raise RetrofitError(
-                f"hinge '{name}': its body has {twin.body_jntnum[body]} joints; backlash needs it alone",
-                reason=Refusal.SHARED_BODY,
                 hinge=name,
             )
         if play.stop == "exact":
@@ -206,6 +226,16 @@ def _check(twin: mujoco.MjModel, spec: mujoco.MjSpec, joints: Mapping[str, Backl
                 f"hinge '{name}' (dof {dof}) has no actuator with joint= on it: backlash sits between a motor and its "
                 "link, and an unactuated hinge has no motor side",
                 reason=Refusal.NO_ACTUATOR,
+                hinge=name,
+            )
+        body = int(twin.jnt_bodyid[j])
+        shared = shared_body(twin, j)
+        if shared is not None:
+            what = "it turns a floating base" if shared is Refusal.FLOATING_BASE else "a compound joint"
+            raise RetrofitError(
+                f"hinge '{name}': its body has {twin.body_jntnum[body]} joints ({what}); backlash needs the hinge "
+                "alone in its body",
+                reason=shared,
                 hinge=name,
             )
         actuated[name] = on_joint
@@ -270,6 +300,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     old_bodies = sorted(bodies)
     actuators = {int(a.id): a for a in work.actuators}
     cls = add_builtin_class(work)
+    motor_mass, motor_inertia = motor_body_mass(twin)
     pending: dict[str, tuple[str, Backlash, str, str, str, tuple[str, ...], float, str]] = {}
     sensors: dict[str, dict[int, str]] = {}
     for name, play in joints.items():
@@ -291,8 +322,8 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
             name=motor_body,
             pos=twin.body_pos[body],
             quat=twin.body_quat[body],
-            mass=MOTOR_MASS,
-            inertia=[MOTOR_MASS] * 3,
+            mass=motor_mass,
+            inertia=[motor_inertia] * 3,
             explicitinertial=True,
             ipos=[0.0, 0.0, 0.0],
             iquat=[1.0, 0.0, 0.0, 0.0],  # set, so the MJCF writer writes the inertial
@@ -371,7 +402,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
     nkeys = extend_paired_keyframes(work, twin, kinematic, qmap, vmap, pairs)
     model = compile_model(work)
     motor_ids = [int(model.body(h.motor_body).id) for h in done.values()]
-    check_masses(twin, model, [int(bodies[b].id) for b in old_bodies], light=motor_ids, light_mass=MOTOR_MASS)
+    check_masses(twin, model, [int(bodies[b].id) for b in old_bodies], light=motor_ids, light_mass=motor_mass)
     motors = {int(twin.joint(n).id): int(model.joint(h.motor_joint).id) for n, h in done.items()}
     check_conventions(twin, model, qmap, vmap, motors=motors, moved_sensors=[k for s in sensors.values() for k in s])
     notes = [
@@ -395,7 +426,7 @@ def add_backlash(spec: mujoco.MjSpec, joints: Mapping[str, Backlash]) -> Backlas
             f"(omega*h <= {OMEGA_H:g} with omega = sqrt(K/J) at the lightest pose sampled); run the twin at this step "
             "to compare"
         )
-    return BacklashRetrofit(work, model, twin_spec, twin, done, nkeys, notes, timestep)
+    return BacklashRetrofit(work, model, twin_spec, twin, done, nkeys, notes, timestep, motor_mass)
 
 
 def _band_note(h: BacklashHinge) -> str:

@@ -15,7 +15,7 @@ import math
 from collections.abc import Sequence
 
 from clearance.contact_calibration.torsional_stop import GOAL, OMEGA_H, STOP_IMPEDANCE
-from clearance.retrofit.backlash import MOTOR_MASS, BacklashHinge, BacklashRetrofit
+from clearance.retrofit.backlash import BacklashHinge, BacklashRetrofit
 from clearance.retrofit.backlash_stop import POSE_SAMPLES
 from clearance.retrofit.play import DEFAULT_MESH_RESTITUTION, DEFAULT_MESH_STIFFNESS
 
@@ -164,6 +164,6 @@ def backlash_report(
         )
     else:
         lines.append(f"Time step: the model's own, {twin_step:g} s.")
-    lines += ["", f"Keyframes extended: {result.keyframes}. Each motor body's mass: {MOTOR_MASS:g} kg."]
+    lines += ["", f"Keyframes extended: {result.keyframes}. Each motor body's mass: {result.motor_mass:g} kg."]
     lines += [f"- asset path: {c}" for c in changes]
     return "\n".join(lines) + "\n"

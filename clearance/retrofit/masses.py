@@ -8,7 +8,8 @@ Three rules, each checked on the compiled result (`check_masses`):
   compiled mass, centre of mass and principal inertia as its explicit inertial and turns the
   rescaling off. (Written to a file, those inertials keep MuJoCo's 6 significant digits.)
 - Elements a retrofit adds carry no mass (a backlash motor body has `MOTOR_MASS`, MuJoCo's floor
-  for a moving body, far below any link).
+  for a moving body, far below any link; in a model with a fluid, the mass that keeps the fluid
+  model's box for it 0.1 mm across: `clearance.retrofit.backlash.motor_body_mass`).
 - A loop closure's pin (`clearance.retrofit.loop`) is a real share of its donor's mass: a point
   mass cut from the donor at the connect's anchor (`split_point_mass`), so donor + pin is the
   original body (mass, centre of mass and inertia; the pin's own isotropic inertia `PIN_INERTIA`

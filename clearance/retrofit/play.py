@@ -56,7 +56,8 @@ class Refusal(enum.Enum):
     """Why a hinge cannot take a kind of play: the reasons a refusal lists (`RetrofitError.reason`)."""
 
     NOT_A_HINGE = "not a hinge (a slide, ball or free joint)"
-    SHARED_BODY = "shares its body with other joints (a compound joint or a planar base)"
+    SHARED_BODY = "shares its body with other joints (a compound joint: hinges through one point)"
+    FLOATING_BASE = "turns a planar floating base (beside slides, on the world: no bearing, no gear)"
     NO_ACTUATOR = "no actuator of its own (backlash sits between a motor and its link)"
     TENDON_DRIVEN = "driven through a tendon (backlash moves only actuators with joint=)"
     TOO_LIGHT = "too light for its bearing or stop: it needs a time step below 1e-7 s"
@@ -330,6 +331,11 @@ class RetrofitOptions:
         use_cache: read and write stored calibrations.
         accept_inaccurate: keep a ring that misses its stated accuracy (the ripple bound, the
             calibration's goals: `clearance.retrofit.accuracy`) with a warning instead of refusing it.
+        robot_step: radial play at the robot's own time step [s], in (0, 0.01]: each journal is held
+            within c by a step-limited tendon stop (`clearance.retrofit.radial_stop`: stock MJCF, no
+            ring, no friction) and the model runs at this step; a clearance the step cannot
+            represent is refused. ``contact_mode``, ``segments``, the geoms and ``timestep`` do not
+            apply. None (the default): the ring or the exact contact at the contact's own µs step.
     """
 
     contact_mode: ContactMode = ContactMode.CALIBRATED
@@ -344,6 +350,7 @@ class RetrofitOptions:
     measure_speed: bool = True
     use_cache: bool = True
     accept_inaccurate: bool = False
+    robot_step: float | None = None
 
     def __post_init__(self) -> None:
         try:
@@ -376,3 +383,11 @@ class RetrofitOptions:
         if not isinstance(self.control, (SineControl, ControlTable)):
             raise RetrofitError(f"control must be a SineControl or a ControlTable (got {self.control!r})")
         positive("sizing_duration", self.sizing_duration, "s")
+        if self.robot_step is not None:
+            if not 0 < positive("robot_step", self.robot_step, "s") <= 1e-2:
+                raise RetrofitError(f"robot_step must be in (0, 0.01] s (got {self.robot_step!r})")
+            if self.timestep is not None:
+                raise RetrofitError(
+                    f"timestep {self.timestep!r} and robot_step {self.robot_step!r} both given: the robot step is the "
+                    "model's time step; give one"
+                )

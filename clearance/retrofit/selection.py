@@ -1,7 +1,8 @@
 """Which hinges a retrofit edits, checked before any work.
 
 A hinge can be given radial play when it exists, is a hinge (not a ball, slide or free
-joint), is the only joint of its body, and the model lets contacts act (the bearing is a
+joint), is the only joint of its body (`shared_body`: a hinge beside others is part of a
+compound joint, or turns a planar floating base), and the model lets contacts act (the bearing is a
 ring of contact pairs); a loop closure (a `connect` equality between two bodies) when one of
 its bodies has a hinge to take the axis from (`clearance.retrofit.loop`). A model that does
 not compile, or that already holds names with the retrofit's prefix, is refused too. Every
@@ -18,7 +19,7 @@ import mujoco
 from clearance.retrofit.loop import check_connect
 from clearance.retrofit.play import DEFAULT_CLASS, PREFIX, Refusal, RetrofitError
 
-__all__ = ["Hinge", "compile_model", "hinge_names", "joint_kind", "select_hinges"]
+__all__ = ["Hinge", "compile_model", "hinge_names", "joint_kind", "select_hinges", "shared_body"]
 
 _OBJ = mujoco.mjtObj
 _JOINT_KIND = {
@@ -74,6 +75,26 @@ class Hinge:
 def joint_kind(model: mujoco.MjModel, joint: int) -> str:
     """How a message names a joint's type: 'a hinge', 'a slide joint', 'a ball joint' or 'a free joint'."""
     return _JOINT_KIND[mujoco.mjtJoint(int(model.jnt_type[joint]))]
+
+
+def shared_body(model: mujoco.MjModel, joint: int) -> Refusal | None:
+    """Why a hinge that shares its body with other joints cannot take play, or None where it is alone.
+
+    `Refusal.FLOATING_BASE` where the body hangs from the world and two or more of its other joints
+    are slides: the hinge turns a planar floating base (gymnasium's runners' ``rooty`` beside
+    ``rootx`` and ``rootz``, the swimmer's ``free_body_rot``), one of the base's freedoms relative to
+    the world, with no bearing to give radial play and no gear to give backlash, as a free joint has
+    none. `Refusal.SHARED_BODY` otherwise: a compound joint (the humanoid's hips, hinges through one
+    point; a swivel on a carriage's rail), whose axes have no body between them to carry a bearing.
+    """
+    body = int(model.jnt_bodyid[joint])
+    if model.body_jntnum[body] == 1:
+        return None
+    first = int(model.body_jntadr[body])
+    kinds = [int(model.jnt_type[k]) for k in range(first, first + int(model.body_jntnum[body])) if k != joint]
+    if model.body_parentid[body] == 0 and kinds.count(int(mujoco.mjtJoint.mjJNT_SLIDE)) >= 2:
+        return Refusal.FLOATING_BASE
+    return Refusal.SHARED_BODY
 
 
 def model_label(spec: mujoco.MjSpec) -> str:
@@ -205,7 +226,8 @@ def select_hinges(spec: mujoco.MjSpec, model: mujoco.MjModel, names: Sequence[st
                 hinge=n,
             )
         body = int(model.jnt_bodyid[jid])
-        if model.body_jntnum[body] != 1:
+        shared = shared_body(model, jid)
+        if shared is not None:
             first = int(model.body_jntadr[body])
             others = [
                 mujoco.mj_id2name(model, _OBJ.mjOBJ_JOINT, k) or f"#{k}"
@@ -213,10 +235,12 @@ def select_hinges(spec: mujoco.MjSpec, model: mujoco.MjModel, names: Sequence[st
                 if k != jid
             ]
             bname = mujoco.mj_id2name(model, _OBJ.mjOBJ_BODY, body) or f"#{body}"
+            what = "and turns a floating base" if shared is Refusal.FLOATING_BASE else "(a compound joint)"
             raise RetrofitError(
-                f"hinge '{n}' shares body '{bname}' with other joints ({', '.join(others)}): radial play needs a "
-                f"body whose only joint is the hinge (hinges of {label} that can: {', '.join(hinges) or 'none'})",
-                reason=Refusal.SHARED_BODY,
+                f"hinge '{n}' shares body '{bname}' with other joints ({', '.join(others)}) {what}: radial "
+                f"play needs a body whose only joint is the hinge (hinges of {label} that can: "
+                f"{', '.join(hinges) or 'none'})",
+                reason=shared,
                 hinge=n,
             )
         out.append(Hinge(n, jid, body, int(model.body_parentid[body])))

@@ -5,8 +5,10 @@ The checks are the retrofit's own (`benchmarks/retrofit_corpus.py` runs them ove
 third-party robots, ``tests/test_retrofit_corpus.py`` over a few of them copied into the tests):
 
 - each hinge is tried alone: a refusal carries its listed reason (`Refusal`; a backlash stop that
-  needs a step below 1e-7 s is `Refusal.TOO_LIGHT` too), and a hinge without an actuator of its own
-  is not eligible for backlash (`Refusal.NO_ACTUATOR`); any other refusal is unlisted;
+  needs a step below 1e-7 s is `Refusal.TOO_LIGHT` too); a hinge is not eligible by its nature
+  (`INELIGIBLE`) where it turns a planar floating base (`Refusal.FLOATING_BASE`: beside two slides in
+  a body on the world, a freedom of the base, as a free joint is, with no bearing and no gear) or, for
+  backlash, has no actuator of its own (`Refusal.NO_ACTUATOR`); any other refusal is unlisted;
 - every accepted hinge at once: the edit compiles and keeps masses (`clearance.retrofit.masses`),
   ranges, reference angles, the softness of every constraint, sensors, actuators and keyframes
   (`clearance.retrofit.conventions`; a break raises RuntimeError, named here); zero play
@@ -41,7 +43,7 @@ from clearance.run.play_candidates import end_effector
 from clearance.run.simulation import SimulationError
 from clearance.run.zero_play import ZERO_BAND, ZeroPlay, backlash_at_zero, radial_at_zero, zero_play
 
-__all__ = ["DRIVE", "DURATION", "Operation", "OperationCheck", "check_operation", "refusal_of"]
+__all__ = ["DRIVE", "DURATION", "INELIGIBLE", "Operation", "OperationCheck", "check_operation", "refusal_of"]
 
 DURATION = 0.1
 """The zero-play check's span [s]."""
@@ -51,6 +53,10 @@ DRIVE = SineControl(amplitude=0.1)
 robosuite's open-loop torque ranges spin a wrist to hundreds of rad/s within 0.1 s (IIWA: 300 rad/s,
 kN of unbalance on its last bearing), where a play's whirl changes the phase of the spin and no
 geometric bound holds; a tenth keeps every corpus arm below 30 rad/s."""
+
+
+INELIGIBLE = frozenset({Refusal.NO_ACTUATOR, Refusal.FLOATING_BASE})
+"""Reasons that make a hinge ineligible by its nature, not refused by the retrofit's limits."""
 
 
 class Operation(enum.Enum):
@@ -79,7 +85,7 @@ class OperationCheck:
     Attributes:
         operation: the operation.
         hinges: every hinge of the model, in joint order.
-        ineligible: hinge -> why it cannot take this play by its nature (no actuator of its own).
+        ineligible: hinge -> why it cannot take this play by its nature (`INELIGIBLE`).
         refused: hinge -> its listed reason, or the message of an unlisted refusal.
         accepted: hinges retrofitted together for the invariants.
         broken: the invariant that broke, with its numbers (None: none broke).
@@ -195,7 +201,7 @@ def _check(spec: mujoco.MjSpec, out: OperationCheck, drive: SineControl, duratio
             _trial(spec, hinge, operation)
         except (RetrofitError, StopStabilityError) as err:
             reason = refusal_of(err)
-            if reason is Refusal.NO_ACTUATOR:
+            if reason in INELIGIBLE:
                 out.ineligible[hinge] = reason
             else:
                 out.refused[hinge] = reason if reason is not None else _line(err)
