@@ -11,7 +11,7 @@ import mujoco
 import numpy as np
 import pytest
 import rerun as rr
-from mujoco import rollout
+from plugin_scenes import rolled_out
 
 import clearance.contact_plugin as cp
 from clearance import ModelOptions, simulate
@@ -30,7 +30,6 @@ from clearance.reference import run_reference
 from clearance.results import SimulationResult
 from clearance.run.preparation import prepare
 from clearance.run.reactions import reaction_layout
-from clearance.run.readout import read_sensors
 
 needs_plugin = pytest.mark.skipif(
     not cp.is_available(), reason="installed without a C compiler: no contact plugin library"
@@ -151,18 +150,15 @@ def test_every_body_obeys_newton(mech, mode):
     model = prepared.model
     data = mujoco.MjData(model)
     mujoco.mj_resetDataKeyframe(model, data, 0)
-    full = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    start = np.empty(mujoco.mj_stateSize(model, full))
-    mujoco.mj_getState(model, data, start, full)
     n = 3000
-    states, sens = rollout.rollout(model, data, start[None], model.key_ctrl[0][None, None], nstep=n)
-    res = read_sensors(prepared, np.arange(n) * model.opt.timestep, sens[0], states[0])
+    res, _, states = rolled_out(prepared, data, n)
+    full = mujoco.mjtState.mjSTATE_FULLPHYSICS
     loads = np.stack([np.hypot(*f.T) for f in res.joint_reactions.values()])
     rows = np.union1d(np.arange(1, n, 37), [max(1, int(np.argmax(loads.max(axis=0))))])  # the hardest impact too
     scale = loads.max()
     acc = np.zeros(6)
     for i in rows:
-        mujoco.mj_setState(model, data, states[0, i - 1], full)  # state row i - 1 is sensor row i's state
+        mujoco.mj_setState(model, data, states[i - 1], full)  # state row i - 1 is sensor row i's state
         data.ctrl[:] = model.key_ctrl[0]
         mujoco.mj_forward(model, data)
         for lk in mech.moving_links:

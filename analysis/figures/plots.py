@@ -23,7 +23,15 @@ from matplotlib.patches import Patch
 from matplotlib.ticker import FormatStrFormatter, MaxNLocator
 
 from clearance.analysis.figures.canvas import Trace, axes_pixels, new_figure, save_png, thin_path
-from clearance.analysis.figures.time_rows import Layout, Row, TimeAxis, band_legend_entry, draw_time_rows, time_axis
+from clearance.analysis.figures.time_rows import (
+    Layout,
+    Row,
+    TimeAxis,
+    band_legend_entry,
+    draw_time_rows,
+    head_and_legend,
+    time_axis,
+)
 from clearance.analysis.metrics.response import ContactMode, JointContactModes, contact_modes
 from clearance.results import SimulationResult, atomic_write_bytes
 from clearance.units import scaled_unit
@@ -35,6 +43,7 @@ __all__ = [
     "plot_orbit",
     "on_times",
     "save_figure",
+    "scale_note",
     "steady_peak",
 ]
 
@@ -99,6 +108,20 @@ def steady_peak(times: np.ndarray, y: np.ndarray, startup: float) -> float:
     k0 = int(np.searchsorted(times, times[0] + startup)) if startup > 0 else 0
     part = y[k0:] if k0 < len(y) else y
     return float(np.max(np.abs(part))) if len(part) else 0.0
+
+
+def scale_note(times: np.ndarray, startup: float) -> str:
+    """A time figure's title note on its y-scale: that of the steady state (after ``startup``), or
+    that the whole run is its start-up window; empty without a start-up window.
+
+    Args:
+        times: (n,) the run's sample times [s].
+        startup: the start-up window from the run's start [s] (0: none).
+    """
+    if not startup > 0:
+        return ""
+    steady = times[-1] > times[0] + startup
+    return "; y-scale of the steady state" if steady else "; the whole run is its start-up window"
 
 
 def plot_response(
@@ -168,23 +191,9 @@ def plot_response(
         layout=Layout(row_height=2.0, top=0.75),
         time=time,
     )
-    handles, names = drawn[0].main.get_legend_handles_labels()
-    if any(d.band for d in drawn):
-        handles.append(band_legend_entry("C3"))
-        names.append(handles[-1].get_label())
-    drawn[0].main.legend(handles, names, loc="upper right", fontsize=7)
     cl = ", ".join(result.joints) or "none"
-    scale_note = ""
-    if startup > 0:
-        steady = result.times[-1] > result.times[0] + startup
-        scale_note = "; y-scale of the steady state" if steady else "; the whole run is its start-up window"
-    fig.text(
-        0.02,
-        1 - 0.3 / fig.get_figheight(),
-        f"{result.metadata.get('mechanism', '')}: {output} (clearance at {cl}){scale_note}",
-        fontsize=11,
-        va="center",
-    )
+    head = f"{result.metadata.get('mechanism', '')}: {output} (clearance at {cl}){scale_note(result.times, startup)}"
+    head_and_legend(fig, drawn, head, band_colour="C3")
     if path is not None:
         save_png(fig, path)
     return fig

@@ -18,7 +18,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from clearance.analysis.figures.canvas import Trace, save_png
-from clearance.analysis.figures.plots import on_times, scaled, steady_peak
+from clearance.analysis.figures.plots import on_times, scale_note, scaled, steady_peak
 from clearance.analysis.figures.time_rows import Layout, Row, band_legend_entry, draw_time_rows, time_axis
 from clearance.analysis.metrics.reactions import ReactionSummary, reaction_magnitudes, summarise_reactions
 from clearance.results import SimulationResult
@@ -92,11 +92,10 @@ def plot_reactions(
         names.append(handles[-1].get_label())
     drawn[0].main.legend(handles, names, loc="upper right", fontsize=7)
     h = fig.get_figheight()
-    scale_note = "; y-scale of the steady state" if startup > 0 else ""
     fig.text(
         0.02,
         1 - 0.22 / h,
-        f"{result.metadata.get('mechanism', '')}: joint reactions and drive torques{scale_note}",
+        f"{result.metadata.get('mechanism', '')}: joint reactions and drive torques{scale_note(result.times, startup)}",
         fontsize=10,
         va="center",
     )

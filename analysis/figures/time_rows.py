@@ -46,6 +46,7 @@ __all__ = [
     "TimeAxis",
     "band_legend_entry",
     "draw_time_rows",
+    "head_and_legend",
     "time_axis",
 ]
 
@@ -375,3 +376,23 @@ def draw_time_rows(
 def band_legend_entry(colour: str = "0.5") -> Patch:
     """The legend's entry for envelope bands (`canvas.draw_series`)."""
     return Patch(color=colour, alpha=BAND_ALPHA, lw=0, label="band: min–max of each pixel column; line: its mean")
+
+
+def head_and_legend(fig: Figure, drawn: list[DrawnRow], head: str, *, band_colour: str = "0.5") -> None:
+    """A time-row figure's head line (top left) and its first row's legend, upper right.
+
+    The legend holds that row's own entries, and the envelope band's (`band_legend_entry`) where
+    any row drew its series as a band.
+
+    Args:
+        fig: the figure of `draw_time_rows`.
+        drawn: its rows.
+        head: the line written above the rows.
+        band_colour: the band's colour in the legend.
+    """
+    handles, names = drawn[0].main.get_legend_handles_labels()
+    if any(d.band for d in drawn):
+        handles.append(band_legend_entry(band_colour))
+        names.append(handles[-1].get_label())
+    drawn[0].main.legend(handles, names, loc="upper right", fontsize=7)
+    fig.text(0.02, 1 - 0.3 / fig.get_figheight(), head, fontsize=11, va="center")
