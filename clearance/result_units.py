@@ -38,6 +38,7 @@ _JOINT_ARRAYS = {
     "eccentricity_rate": "m/s",
     "penetration": "m",
     "contact_force": "N",
+    "film_force": "N",
     "approach_speed": "m/s",
     "friction_force": "N",
     "contact_torque": "N m",

@@ -35,6 +35,7 @@ from typing import Any
 
 import numpy as np
 
+from clearance.joint_result import JointResult as JointResult
 from clearance.translational import SLIDER_FIELDS, SliderResult
 
 __all__ = [
@@ -96,39 +97,6 @@ def atomic_write_text(path: str | os.PathLike, text: str) -> None:
     """Write UTF-8 text to ``path`` atomically."""
     atomic_write_bytes(path, text.encode("utf-8"))
 
-
-@dataclass
-class JointResult:
-    """Per-clearance-joint series, all in the bearing frame.
-
-    Attributes:
-        eccentricity: (n, 2) journal-centre position relative to the bearing centre [m].
-        eccentricity_rate: (n, 2) its time derivative [m/s].
-        penetration: (n,) |e| - c [m]; positive means in contact.
-        contact_force: (n, 2) net contact force on the journal [N].
-    """
-
-    eccentricity: np.ndarray
-    eccentricity_rate: np.ndarray
-    penetration: np.ndarray
-    contact_force: np.ndarray
-
-    @property
-    def force_magnitude(self) -> np.ndarray:
-        """(n,) magnitude of the contact force [N]."""
-        return np.hypot(self.contact_force[:, 0], self.contact_force[:, 1])
-
-    def sliced(self, sl: slice | np.ndarray) -> JointResult:
-        """The same series restricted to ``sl`` (rows)."""
-        return JointResult(
-            self.eccentricity[sl],
-            self.eccentricity_rate[sl],
-            self.penetration[sl],
-            self.contact_force[sl],
-        )
-
-
-_JOINT_FIELDS = ("eccentricity", "eccentricity_rate", "penetration", "contact_force")
 
 ENERGY_TERMS: dict[str, str] = {
     "kinetic": "kinetic energy ½ v'Mv of the links and the drives' armature [J]",
@@ -228,7 +196,9 @@ class SimulationResult:
         times: (n,) [s].
         outputs: name -> (n,) output position [m or rad]; ``<name>_vel`` and ``<name>_acc``
             hold its first and second time derivatives.
-        joints: clearance joint name -> `JointResult`.
+        joints: clearance joint name -> `JointResult` (`clearance.joint_result`); a lubricated
+            joint's carries its oil film's force ``film_force`` too (None for a dry joint and in
+            files saved before the field existed).
         drive_angle, drive_speed, drive_torque: (n, n_drives) [rad, rad/s, N m].
         link_poses: (n, n_links, 3) pose (x [m], y [m], theta [rad]) of each moving link.
         closure_violation: (n,) largest ideal loop-closure error [m] (zeros if none).
@@ -313,10 +283,7 @@ class SimulationResult:
         return SimulationResult(
             times=cat([p.times for p in parts]),
             outputs={k: cat([p.outputs[k] for p in parts]) for k in first.outputs},
-            joints={
-                k: JointResult(*(cat([getattr(p.joints[k], f) for p in parts]) for f in _JOINT_FIELDS))
-                for k in first.joints
-            },
+            joints={k: JointResult.concatenate([p.joints[k] for p in parts]) for k in first.joints},
             drive_angle=cat([p.drive_angle for p in parts]),
             drive_speed=cat([p.drive_speed for p in parts]),
             drive_torque=cat([p.drive_torque for p in parts]),
@@ -347,8 +314,8 @@ class SimulationResult:
         for k, v in self.outputs.items():
             arrays[f"output/{k}"] = v
         for j, jr in self.joints.items():
-            for f in _JOINT_FIELDS:
-                arrays[f"joint/{j}/{f}"] = getattr(jr, f)
+            for f, v in jr.series().items():
+                arrays[f"joint/{j}/{f}"] = v
         for k, v in self.energy.items():
             arrays[f"energy/{k}"] = v
         for k, v in self.joint_reactions.items():
@@ -410,7 +377,8 @@ class SimulationResult:
             return cls(
                 times=z["times"],
                 outputs={k: z[f"output/{k}"] for k in out_names},
-                joints={j: JointResult(*(z[f"joint/{j}/{f}"] for f in _JOINT_FIELDS)) for j in joint_names},
+                # a joint's optional series (a lubricated joint's film force) only where saved
+                joints={j: JointResult.from_series(_joint_arrays(z, j)) for j in joint_names},
                 drive_angle=z["drive_angle"],
                 drive_speed=z["drive_speed"],
                 drive_torque=z["drive_torque"],
@@ -422,6 +390,12 @@ class SimulationResult:
                 body_poses=z["body_poses"] if "body_poses" in z.files else np.zeros((0, 0, 7)),
                 sliders={j: SliderResult(*(z[f"slider/{j}/{f}"] for f in SLIDER_FIELDS)) for j in slider_names},
             )
+
+
+def _joint_arrays(z: Any, joint: str) -> dict[str, np.ndarray]:
+    """A saved joint's series by field name, from an open ``.npz`` (``joint/<joint>/<field>``)."""
+    prefix = f"joint/{joint}/"
+    return {k[len(prefix) :]: z[k] for k in z.files if k.startswith(prefix) and "/" not in k[len(prefix) :]}
 
 
 def _json_default(o: object) -> object:

@@ -38,6 +38,7 @@ __all__ = [
     "check_thresholds",
     "normal_force_scalar",
     "friction_scalar",
+    "film_at",
 ]
 
 _HERTZ, _CHI, _IMPACT = 0, 1, 2
@@ -312,14 +313,36 @@ def evaluate_contact(cj: ContactJoint, zl: Sequence[float], zdl: Sequence[float]
             rbx, rby = abx + cj.rb * nx, aby + cj.rb * ny
             mj = rjx * fy - rjy * fx
             mb = -(rbx * fy - rby * fx)
-    film = _film(cj.clearance)
+    film = film_at(cj, ex, ey, edx, edy, wj, wb)
     if film is not None:
-        # e's rate seen from the bearing: e' - w_B z x e; the spin relative to the bearing
-        gx, gy, tj, tb = film_scalar(film, ex, ey, edx + wb * ey, edy - wb * ex, wj - wb)
+        gx, gy, tj, tb = film
         fx, fy = fx + gx, fy + gy
         mj += ajx * gy - ajy * gx + tj
         mb += -(abx * gy - aby * gx) + tb
     return ex, ey, edx, edy, delta, ddot, vt, fx, fy, mj, mb, fn, ft
+
+
+def film_at(
+    cj: ContactJoint, ex: float, ey: float, edx: float, edy: float, wj: float, wb: float
+) -> tuple[float, float, float, float] | None:
+    """A lubricated joint's film force and torques at one state (world frame); None for a dry joint.
+
+    Args:
+        cj: the joint.
+        ex, ey: eccentricity e, journal centre minus bearing centre [m].
+        edx, edy: its rate ė [m/s] (world frame, as `evaluate_contact` computes it).
+        wj, wb: angular velocities of the journal's and the bearing's links [rad/s].
+
+    Returns:
+        (F_x, F_y, T_J, T_B) of `clearance.contact_calibration.film.film_scalar`: the film force on
+        the journal [N] in world axes and the shear torques on journal and bearing [N m]; e's rate
+        enters as seen from the bearing (ė − ω_B z × e) and the spin as the journal's relative to
+        the bearing.
+    """
+    film = _film(cj.clearance)
+    if film is None:
+        return None
+    return film_scalar(film, ex, ey, edx + wb * ey, edy - wb * ex, wj - wb)
 
 
 @functools.cache

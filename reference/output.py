@@ -5,7 +5,8 @@ that sample) for accelerations, contact forces and drive torques. Frames and sig
 
   * eccentricity: journal centre minus bearing centre in the bearing link's frame;
     eccentricity_rate: the time derivative of that frame-expressed vector;
-  * contact_force: force on the journal (normal + friction) in the bearing frame;
+  * contact_force: force on the journal (normal + friction, and a lubricated joint's film) in
+    the bearing frame; film_force: the film's part of it (`contact.film_at` at the sample's state);
   * drive_angle, drive_speed: theta_b - theta_a of the driven joint and its rate;
     drive_torque: torque the drive applies to link_b (positive work at positive speed);
   * closure_violation: largest ideal-joint closure error [m] (revolute: norm of the
@@ -27,7 +28,7 @@ from typing import Any
 import numpy as np
 
 from clearance.kinematics import output_kinematics
-from clearance.reference.contact import ContactJoint
+from clearance.reference.contact import ContactJoint, film_at
 from clearance.reference.corner_contact import CornerContact
 from clearance.reference.integrator import Trajectory
 from clearance.reference.system import ReferenceSystem
@@ -82,7 +83,10 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
         erate = np.stack([c * edx + s * edy + w * e[:, 1], -s * edx + c * edy - w * e[:, 0]], axis=1)
         force = np.stack([c * fx + s * fy, -s * fx + c * fy], axis=1)
         pen = np.hypot(e[:, 0], e[:, 1]) - cj.c
-        joints[cj.name] = JointResult(e, erate, pen, force)
+        film = _film_series(cj, traj, cres[:, k, :4])
+        if film is not None:
+            film = np.stack([c * film[:, 0] + s * film[:, 1], -s * film[:, 0] + c * film[:, 1]], axis=1)
+        joints[cj.name] = JointResult(e, erate, pen, force, film)
 
     reactions = _reactions(system, q, lam, cres)
     corners: dict[str, list[int]] = {}
@@ -132,6 +136,32 @@ def assemble_result(system: ReferenceSystem, traj: Trajectory, metadata: dict[st
         joint_reactions=reactions,
         sliders=sliders,
     )
+
+
+def _film_series(cj: ContactJoint, traj: Trajectory, geometry: np.ndarray) -> np.ndarray | None:
+    """A lubricated joint's film force on the journal at every sample, world frame [N], (n, 2).
+
+    `clearance.reference.contact.film_at` at each sample's state (the eccentricity and its rate
+    as the sample's evaluation computed them, the links' angular velocities), so the series is
+    the film part of the contact force the solver applied there; None for a dry joint.
+
+    Args:
+        cj: the joint.
+        traj: the run (its velocities give the links' spin).
+        geometry: (n, 4) the samples' e (world) [m] and ė [m/s], columns 0-3 of the evaluations.
+    """
+    if cj.clearance.lubrication is None:
+        return None
+    n = len(geometry)
+    wj = traj.zd[:, 3 * cj.ij + 2] if cj.ij >= 0 else np.zeros(n)
+    wb = traj.zd[:, 3 * cj.ib + 2] if cj.ib >= 0 else np.zeros(n)
+    out = np.empty((n, 2))
+    for i, ((ex, ey, edx, edy), a, b) in enumerate(zip(geometry.tolist(), wj.tolist(), wb.tolist())):
+        film = film_at(cj, ex, ey, edx, edy, a, b)
+        if film is None:
+            return None
+        out[i] = film[:2]
+    return out
 
 
 def _slider(system: ReferenceSystem, traj: Trajectory, cres: np.ndarray, ks: list[int]) -> SliderResult:

@@ -21,6 +21,7 @@ FLOORS: dict[str, str] = {
     "clearance.model": "data model",
     "clearance.options": "data model",
     "clearance.results": "data model",
+    "clearance.joint_result": "data model",
     "clearance.constraints": "data model",
     "clearance.kinematics": "data model",
     "clearance.units": "data model",

@@ -22,6 +22,7 @@ from clearance.analysis.figures import analysis_figures as figures
 from clearance.analysis.figures import plots
 from clearance.analysis.figures.deviation_figure import plot_deviation
 from clearance.analysis.figures.drawing import draw, figures_in_parallel, start_child
+from clearance.analysis.figures.film_figures import film_section
 from clearance.analysis.figures.report_sections import (
     Window,
     clearance_of,
@@ -260,6 +261,7 @@ def _report_lines(
     lines += _deviation_lines(result, ideal, output, window, out)
     if result.joints:
         lines += contact_section(result, window, out)
+        lines += film_section(result, window, out)  # lubricated joints: the film beside the orbits
     if result.sliders:  # sliders with play: position and tilt in the guide, contact cases
         from clearance.analysis.figures.slider_figures import slider_section
 

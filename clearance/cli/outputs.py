@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -16,6 +16,7 @@ from clearance.results import SimulationResult
 from clearance.units import format_quantity
 
 if TYPE_CHECKING:
+    from clearance.analysis.metrics.film import FilmSummary
     from clearance.analysis.metrics.reactions import ReactionSummary
     from clearance.analysis.metrics.summary import JointSummary
 
@@ -135,29 +136,55 @@ def write_outputs(
     write_report(out, result, ideal, skip=skip, processes=2 if (os.cpu_count() or 1) >= 2 else 1, reactions=reactions)
     if stopped is not None:
         note_stop(out / "report.md", stopped)
-    for line in console_lines(mech, rows, reactions):
+    from clearance.analysis.metrics.film import film_summaries
+
+    for line in console_lines(mech, rows, reactions, films=film_summaries(result)):
         print(line)
 
 
-def console_lines(mech: Mechanism, rows: list[JointSummary], reactions: list[ReactionSummary]) -> list[str]:
+def console_lines(
+    mech: Mechanism,
+    rows: list[JointSummary],
+    reactions: list[ReactionSummary],
+    *,
+    films: Sequence[FilmSummary] = (),
+) -> list[str]:
     """The run's numbers for the console: contact per joint, reaction peaks, the output's deviation.
 
     Every number is in the unit its size calls for (`clearance.units.format_quantity`: 45.9 kN,
-    252 µs), and every statistic says whether it is over the whole run or the steady state.
+    252 µs), and every statistic says whether it is over the whole run or the steady state. A
+    lubricated joint says whether its oil film carried the load (its minimum film thickness,
+    largest eccentricity ratio and peak film force) or ruptured into dry contact.
 
     Args:
         mech: the mechanism that ran (its first output is the one measured).
         rows: `summarise`'s rows, one per clearance joint.
         reactions: `summarise_reactions`' rows.
+        films: `film_summaries`' rows over the whole run, one per lubricated joint.
     """
     q = format_quantity
     lines = []
+    oiled = {f.joint: f for f in films}
     for r in rows:
+        film = oiled.get(r.joint)
+        if film is not None and film.film_carried_the_load:
+            lines.append(
+                f"  {r.joint}: no dry contact: the oil film carried the load (minimum film thickness "
+                f"{q(film.min_film_thickness, 'm')}, largest eccentricity ratio {film.max_eccentricity_ratio:.3g}, "
+                f"peak film force {q(film.peak_film_force, 'N')} at {q(film.peak_film_force_time, 's')})"
+            )
+            continue
         if not r.max_penetration > 0:  # penetration = |e| - c never above 0: the journal never touched
             lines.append(
                 f"  {r.joint}: no contact (the journal stayed at least {q(-r.max_penetration, 'm')} from the bearing)"
             )
             continue
+        if film is not None:
+            lines.append(
+                f"  {r.joint}: the oil film ruptured: dry contact in {film.dry_fraction:.1%} of the run "
+                f"(largest eccentricity ratio {film.max_eccentricity_ratio:.3g}; peak film force "
+                f"{q(film.peak_film_force, 'N')}); the force below is film and dry contact together"
+            )
         lines.append(
             f"  {r.joint}, whole run: peak force {q(r.peak_force, 'N', digits=4)} at {q(r.peak_force_time, 's')}, "
             f"p95 {q(r.p95_force, 'N', digits=4)}, {r.impacts} impacts, in contact {r.contact_fraction:.1%}, "

@@ -37,20 +37,25 @@ def sensor_slices(model: mujoco.MjModel) -> dict[str, slice]:
     return out
 
 
-def _exact_contact_force(sens: np.ndarray, at: dict[str, int], e: np.ndarray) -> np.ndarray:
-    """Contact force on the journal [N], (n, 2) in the bearing frame, as the ring's contact sensor gives it.
+def _exact_contact_force(
+    sens: np.ndarray, at: dict[str, int], e: np.ndarray, lubricated: bool
+) -> tuple[np.ndarray, np.ndarray | None]:
+    """Contact force on the journal [N], (n, 2) in the bearing frame, as the ring's contact sensor
+    gives it, and a lubricated joint's film force (its part of it; None for a dry joint).
 
     The plugin gives the normal force F_n >= 0 and the tangential force F_t on the journal
     along t = z x n, n = e/|e|: the force on the journal is -F_n n + F_t t, plus a lubricated
-    joint's film force (its components along n and t; 0 for a dry joint).
+    joint's film force G_n n + G_t t (its components along n and t; 0 for a dry joint).
     """
     r = np.hypot(e[:, 0], e[:, 1])
     safe = np.where(r > 0, r, 1.0)
     n = np.where(r[:, None] > 0, e / safe[:, None], np.array([1.0, 0.0]))
     t = np.stack([-n[:, 1], n[:, 0]], axis=1)
-    fn = sens[:, at["normal_force"]] - sens[:, at["film_normal_force"]]
-    ft = sens[:, at["tangential_force"]] + sens[:, at["film_tangential_force"]]
-    return -fn[:, None] * n + ft[:, None] * t
+    gn, gt = sens[:, at["film_normal_force"]], sens[:, at["film_tangential_force"]]
+    fn = sens[:, at["normal_force"]] - gn
+    ft = sens[:, at["tangential_force"]] + gt
+    film = gn[:, None] * n + gt[:, None] * t if lubricated else None
+    return -fn[:, None] * n + ft[:, None] * t, film
 
 
 def _angle(xaxis: np.ndarray, before: float | None) -> np.ndarray:
@@ -128,15 +133,17 @@ def read_sensors(
         erate = np.stack(
             [c * dv[:, 0] + s * dv[:, 1] + w * e[:, 1], -s * dv[:, 0] + c * dv[:, 1] - w * e[:, 0]], axis=1
         )
+        film = None
         if prepared.built.exact_contact:
-            force = _exact_contact_force(sens, sensor_offsets(model, exact_contact_name(jname)), e)
+            oiled = mech.joint(jname).require_clearance().lubrication is not None
+            force, film = _exact_contact_force(sens, sensor_offsets(model, exact_contact_name(jname)), e, oiled)
             journal_world[jname] = rotate(bx, force)
         else:
             fw = get(f"{jname}__force")[:, :2]
             force = np.stack([c * fw[:, 0] + s * fw[:, 1], -s * fw[:, 0] + c * fw[:, 1]], axis=1)
             journal_world[jname] = fw.copy()
         pen = np.hypot(e[:, 0], e[:, 1]) - ring.radial_clearance
-        joints[jname] = JointResult(e, erate, pen, force)
+        joints[jname] = JointResult(e, erate, pen, force, film)
 
     if prepared.reactions is None:
         tree = prepared.built.tree
