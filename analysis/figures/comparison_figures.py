@@ -20,7 +20,7 @@ from matplotlib.ticker import FormatStrFormatter, LogLocator, NullFormatter
 
 from clearance.analysis.chaos.poincare import PoincareClassification
 from clearance.analysis.figures.analysis_figures import plot_poincare, quantity_label
-from clearance.analysis.figures.canvas import new_figure
+from clearance.analysis.figures.canvas import new_figure, thin_path
 from clearance.analysis.figures.plots import save_figure
 from clearance.analysis.sweeps.criticality import CriticalityRanking
 from clearance.results import SimulationResult
@@ -29,6 +29,7 @@ __all__ = [
     "OrbitPanel",
     "PoincarePanel",
     "TrendPanel",
+    "plot_orbit_panels",
     "plot_orbit_phase_panels",
     "plot_output_overlay",
     "plot_poincare_panels",
@@ -181,6 +182,41 @@ class OrbitPanel:
     clearance: float
     title: str
     period: float | None = None
+
+
+def plot_orbit_panels(panels: Sequence[OrbitPanel], *, title: str = "", path: str | Path | None = None) -> Figure:
+    """Journal-centre orbits side by side, each inside its clearance circle (bearing frame, µm).
+
+    Each panel draws its run's eccentricity path (thinned to about a pixel, `canvas.thin_path`)
+    on the same scale as the others, so that a journal held off the wall (an oil film) and one
+    sliding along it read at a glance.
+
+    Args:
+        panels: the `OrbitPanel`s (their ``period`` is not used).
+        title: figure title.
+        path: PNG path to save to.
+    """
+    reach = max(max(p.clearance, float(np.abs(p.result.joints[p.joint].eccentricity).max())) for p in panels)
+    lim = 1.15 * reach * 1e6
+    th = np.linspace(0.0, 2.0 * np.pi, 400)
+
+    def draw(ax: Axes, k: int) -> None:
+        p = panels[k]
+        e = p.result.joints[p.joint].eccentricity * 1e6
+        keep = thin_path(e[:, 0], e[:, 1])
+        c = p.clearance * 1e6
+        ax.plot(c * np.cos(th), c * np.sin(th), color="k", lw=1.0, ls="--", label=f"clearance circle, c = {c:g} µm")
+        ax.plot(e[keep, 0], e[keep, 1], color="C0", lw=0.7, label="journal centre")
+        ax.set_aspect("equal")
+        ax.set_xlim(-lim, lim)
+        ax.set_ylim(-lim, lim)
+        ax.set_xlabel(f"{p.joint} eccentricity x [µm]")
+        ax.set_ylabel(f"{p.joint} eccentricity y [µm]")
+        ax.set_title(p.title, fontsize=10)
+        ax.legend(loc="upper right", fontsize=7)
+        ax.grid(alpha=0.3)
+
+    return _panel_row(len(panels), 4.6, 4.6, draw, title, path)
 
 
 def plot_orbit_phase_panels(panels: Sequence[OrbitPanel], *, title: str = "", path: str | Path | None = None) -> Figure:
