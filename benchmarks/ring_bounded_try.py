@@ -178,7 +178,7 @@ def fit_shaped(
         )
         p, holder["solimp"] = params_of(sol.x)
         err, _, _ = evaluate(clearance, ring, options, p, mass=mass, speeds=speeds, directions=directions, refs=refs)
-    return Fit(p, holder["solimp"], mass, speeds, nfev, fitmod._rows(speeds, err, refs))
+    return Fit(p, holder["solimp"], mass, speeds, nfev, fitmod.speed_rows(speeds, err, refs))
 
 
 def impact_mass(prep: PreparedModel, mech: Mechanism, joint: str, window: float) -> tuple[float, float]:

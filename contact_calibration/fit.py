@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING
 
@@ -71,6 +71,8 @@ __all__ = [
     "accuracy_rows",
     "check_stability",
     "fit_contact",
+    "fit_stages",
+    "speed_rows",
 ]
 
 GOALS = {"peak_force": 0.05, "max_penetration": 0.05, "duration": 0.10, "restitution": 0.02}
@@ -308,7 +310,8 @@ def evaluate(
     return err, imps, refs
 
 
-def _rows(speeds: np.ndarray, err: np.ndarray, refs: list[ImpactResult]) -> tuple[SpeedRow, ...]:
+def speed_rows(speeds: np.ndarray, err: np.ndarray, refs: list[ImpactResult]) -> tuple[SpeedRow, ...]:
+    """One `SpeedRow` per speed from the errors (n_v, n_d, 4) of impacts against ``refs``."""
     out = []
     for v, e, r in zip(speeds, err, refs):
         mean = e.mean(axis=0)
@@ -339,7 +342,7 @@ def accuracy_rows(
     """Accuracy of ``params`` against the reference at any ``speeds`` [m/s] (see `evaluate`)."""
     speeds = np.asarray(speeds, dtype=float)
     err, _, refs = evaluate(clearance, ring, options, params, mass=mass, speeds=speeds, directions=directions)
-    return _rows(speeds, err, refs)
+    return speed_rows(speeds, err, refs)
 
 
 def check_stability(
@@ -402,6 +405,82 @@ def check_stability(
     return st
 
 
+def fit_stages(
+    errors: Callable[[ContactParameters], np.ndarray],
+    start: ContactParameters,
+    *,
+    n_residuals: int,
+    max_nfev: int = 60,
+    shape: bool = True,
+) -> tuple[ContactParameters, list[str], int]:
+    """The calibration's two least-squares stages for any impact scene (module docstring).
+
+    Stage 1 fits (log k, log b) at constant impedance from ``start``; stage 2, with ``shape``,
+    (log k, log b, ε) from ε = `EPS_START`, 0 <= ε <= `EPS_MAX`, the first stage's k and b
+    carried to full impedance. Each residual is an error divided by its goal (`GOALS`).
+
+    Args:
+        errors: contact parameters -> (..., 4) errors [F rel, δ rel, T rel, e abs] of the
+            scene's impacts against the reference; it raises RuntimeError for a diverged or
+            failed scene (then every residual counts 1e3).
+        start: the nominal parameters.
+        n_residuals: how many errors ``errors`` returns (4 per impact).
+        max_nfev: limit on stage 1's evaluations (stage 2's is `SHAPE_MAX_NFEV`).
+        shape: run stage 2.
+
+    Returns:
+        (the fitted parameters with source "calibrated", the optimizer's messages, evaluations).
+    """
+    from scipy.optimize import least_squares  # here, not at import (see reference_impacts)
+
+    scale = np.array([GOALS["peak_force"], GOALS["max_penetration"], GOALS["duration"], GOALS["restitution"]])
+    nfev = 0
+
+    def params_of(x: np.ndarray, source: str) -> ContactParameters:
+        eps = min(max(float(x[2]), 0.0), EPS_MAX) if len(x) > 2 else 0.0  # least_squares keeps it inside
+        return ContactParameters(float(np.exp(x[0])), float(np.exp(x[1])), source, eps)
+
+    def residuals(x: np.ndarray) -> np.ndarray:
+        nonlocal nfev
+        nfev += 1
+        try:
+            err = errors(params_of(x, "fit"))
+        except RuntimeError:
+            return np.full(n_residuals, 1e3)  # diverged/failed: far off
+        return (err / scale).ravel()
+
+    # stage 1: (log k, log b) at constant impedance, from the nominal values
+    x0 = np.log([start.stiffness, max(start.damping, 1e-9 * start.stiffness)])
+    sol = least_squares(
+        residuals, x0, method="trf", diff_step=1e-3, x_scale=1.0, max_nfev=max_nfev, xtol=1e-6, ftol=1e-8
+    )
+    messages = [f"(log k, log b): {sol.message}"]
+    if shape:
+        # stage 2: (log k, log b, eps); k and b are the rows' values at full impedance, so the
+        # first stage's are carried there (its rows at constant impedance d(1 - eps0))
+        first = params_of(sol.x, "fit")
+        x1 = np.array(
+            [
+                math.log(first.stiffness / (1 - EPS_START) ** 2),
+                math.log(first.damping / (1 - EPS_START)),
+                EPS_START,
+            ]
+        )
+        sol = least_squares(
+            residuals,
+            x1,
+            bounds=([-np.inf, -np.inf, 0.0], [np.inf, np.inf, EPS_MAX]),
+            method="trf",
+            diff_step=1e-3,
+            x_scale=1.0,
+            max_nfev=SHAPE_MAX_NFEV,
+            xtol=1e-6,
+            ftol=1e-8,
+        )
+        messages.append(f"(log k, log b, eps): {sol.message}")
+    return params_of(sol.x, "calibrated"), messages, nfev
+
+
 def fit_contact(
     clearance: Clearance,
     ring: RingGeometry,
@@ -440,8 +519,6 @@ def fit_contact(
         CalibrationStabilityError: the fitted parameters are unstable at the time step.
         ValueError: bad arguments (mass, speeds) or an unsupported law.
     """
-    from scipy.optimize import least_squares  # here, not at import (see reference_impacts)
-
     t0 = time.perf_counter()
     if not (math.isfinite(mass) and mass > 0):
         raise ValueError(f"mass must be positive and finite (got {mass!r} kg)")
@@ -455,55 +532,13 @@ def fit_contact(
     start = nominal_parameters(
         clearance, ring, effective_mass=mass, impact_speed=float(np.sqrt(speeds[0] * speeds[-1]))
     )
-    scale = np.array([GOALS["peak_force"], GOALS["max_penetration"], GOALS["duration"], GOALS["restitution"]])
-    nfev = 0
+    n_res = len(speeds) * len(directions) * 4
 
-    def params_of(x: np.ndarray, source: str) -> ContactParameters:
-        eps = min(max(float(x[2]), 0.0), EPS_MAX) if len(x) > 2 else 0.0  # least_squares keeps it inside
-        return ContactParameters(float(np.exp(x[0])), float(np.exp(x[1])), source, eps)
+    def errors(p: ContactParameters) -> np.ndarray:
+        err, _, _ = evaluate(clearance, ring, options, p, mass=mass, speeds=speeds, directions=directions, refs=refs)
+        return err
 
-    def residuals(x: np.ndarray) -> np.ndarray:
-        nonlocal nfev
-        nfev += 1
-        p = params_of(x, "fit")
-        try:
-            err, _, _ = evaluate(
-                clearance, ring, options, p, mass=mass, speeds=speeds, directions=directions, refs=refs
-            )
-        except RuntimeError:
-            return np.full(len(speeds) * len(directions) * 4, 1e3)  # diverged/failed: far off
-        return (err / scale).ravel()
-
-    # stage 1: (log k, log b) at constant impedance, from the nominal values
-    x0 = np.log([start.stiffness, max(start.damping, 1e-9 * start.stiffness)])
-    sol = least_squares(
-        residuals, x0, method="trf", diff_step=1e-3, x_scale=1.0, max_nfev=max_nfev, xtol=1e-6, ftol=1e-8
-    )
-    messages = [f"(log k, log b): {sol.message}"]
-    if shape_impedance:
-        # stage 2: (log k, log b, eps); k and b are the rows' values at full impedance, so the
-        # first stage's are carried there (its rows at constant impedance d(1 - eps0))
-        first = params_of(sol.x, "fit")
-        x1 = np.array(
-            [
-                math.log(first.stiffness / (1 - EPS_START) ** 2),
-                math.log(first.damping / (1 - EPS_START)),
-                EPS_START,
-            ]
-        )
-        sol = least_squares(
-            residuals,
-            x1,
-            bounds=([-np.inf, -np.inf, 0.0], [np.inf, np.inf, EPS_MAX]),
-            method="trf",
-            diff_step=1e-3,
-            x_scale=1.0,
-            max_nfev=SHAPE_MAX_NFEV,
-            xtol=1e-6,
-            ftol=1e-8,
-        )
-        messages.append(f"(log k, log b, eps): {sol.message}")
-    params = params_of(sol.x, "calibrated")
+    params, messages, nfev = fit_stages(errors, start, n_residuals=n_res, max_nfev=max_nfev, shape=shape_impedance)
     err, _, _ = evaluate(clearance, ring, options, params, mass=mass, speeds=speeds, directions=directions, refs=refs)
     dmax = max_penetration if max_penetration is not None else 4 * refs[-1].max_penetration
     stab = check_stability(ring, params, mass=mass, timestep=options.timestep, max_penetration=dmax)
@@ -515,7 +550,7 @@ def fit_contact(
         timestep=options.timestep,
         speeds=tuple(float(v) for v in speeds),
         directions=tuple(float(d) for d in directions),
-        rows=_rows(speeds, err, refs),
+        rows=speed_rows(speeds, err, refs),
         stability=stab,
         nfev=nfev,
         wall_time=time.perf_counter() - t0,

@@ -34,7 +34,15 @@ from clearance.mjcf.contact import row_solimp
 from clearance.mjcf.probe import ring_scene
 from clearance.options import ContactParameters, ModelOptions
 
-__all__ = ["SceneImpact", "impact_scene", "ring_gap", "onset_radius", "scene_impacts", "DEFAULT_DIRECTIONS"]
+__all__ = [
+    "SceneImpact",
+    "impact_scene",
+    "ring_gap",
+    "onset_radius",
+    "scene_impacts",
+    "measure_impact",
+    "DEFAULT_DIRECTIONS",
+]
 
 DEFAULT_DIRECTIONS = (0.0, 0.5)
 """Impact directions as fractions of the segment pitch 2π/N: at a segment, between two."""
@@ -214,7 +222,36 @@ def _measure(
     q: np.ndarray, qd: np.ndarray, ring: RingGeometry, mass: float, h: float, v: float, psi: float
 ) -> SceneImpact:
     u = np.array([math.cos(psi), math.sin(psi)])
-    gap = ring_gap(ring, q)
+    delta = np.linalg.norm(q, axis=1) - ring.radial_clearance
+    return measure_impact(ring_gap(ring, q), delta, qd @ u, mass=mass, h=h, speed=v, direction=psi)
+
+
+def measure_impact(
+    gap: np.ndarray,
+    delta: np.ndarray,
+    rate: np.ndarray,
+    *,
+    mass: float,
+    h: float,
+    speed: float,
+    direction: float = 0.0,
+) -> SceneImpact:
+    """Measure one impact of a stepped scene (the quantities of the module docstring).
+
+    Args:
+        gap: (n,) signed distance of the actual geoms at each state [m] (< 0: touching).
+        delta: (n,) the penetration a run reports at each state [m].
+        rate: (n,) the impacting body's velocity along the approach direction [m/s] (> 0
+            approaching): the force during step k is -m (rate[k+1] - rate[k]) / h.
+        mass: the impacting mass [kg].
+        h: the time step [s].
+        speed: the approach speed v [m/s].
+        direction: the impact's direction [rad], recorded.
+
+    Raises:
+        RuntimeError: no contact, or no separation before the last two states.
+    """
+    v, psi = speed, direction
     touching = np.flatnonzero(gap < 0)
     if len(touching) == 0:
         raise RuntimeError(f"no contact in the impact at v = {v:g} m/s (direction {psi:.4f} rad)")
@@ -228,8 +265,7 @@ def _measure(
     last = first + int(after[0]) - 1
     t_on = (first - 1 + _crossing(gap[first - 1], gap[first])) * h
     t_off = (last + _crossing(gap[last], gap[last + 1])) * h
-    force = -mass * np.diff(qd @ u) / h  # force during step k, from state k
-    delta = np.linalg.norm(q, axis=1) - ring.radial_clearance
+    force = -mass * np.diff(rate) / h  # force during step k, from state k
     lo, hi = max(first - 1, 0), min(last + 2, len(force))
     fpk, _ = _peak(force[lo:hi])
     dpk, _ = _peak(delta[lo : hi + 1])
@@ -243,5 +279,5 @@ def _measure(
         peak_force=fpk,
         max_penetration=dpk,
         duration=t_off - t_on,
-        restitution=-float(qd[last + 2] @ u) / v,
+        restitution=-float(rate[last + 2]) / v,
     )
