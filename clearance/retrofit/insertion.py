@@ -30,6 +30,7 @@ __all__ = [
     "add_slides_and_sites",
     "add_bearing",
     "add_bearing_frame",
+    "add_eccentricity_sensor",
     "add_exact_contact",
     "bearing_frame_name",
     "exact_contact_name",
@@ -174,7 +175,7 @@ def add_bearing(
     elements.journal_geom = added.journal.name
     elements.segments = [g.name for g in added.segments]
     elements.pairs = [p.name for p in added.pairs]
-    ecc = _eccentricity_sensor(spec, elements)
+    ecc = add_eccentricity_sensor(spec, elements)
     force = spec.add_sensor(
         name=f"{prefix}__force", type=_SENS.mjSENS_CONTACT, objtype=_OBJ.mjOBJ_GEOM, objname=added.journal.name
     )
@@ -183,7 +184,8 @@ def add_bearing(
     return added
 
 
-def _eccentricity_sensor(spec: mujoco.MjSpec, elements: PlayElements) -> mujoco.MjsSensor:
+def add_eccentricity_sensor(spec: mujoco.MjSpec, elements: PlayElements) -> mujoco.MjsSensor:
+    """Add the sensor ``clr_<hinge>__ecc``: the journal's centre in the bearing frame [m] (framepos)."""
     ecc = spec.add_sensor(
         name=f"{prefix_of(elements.hinge)}__ecc",
         type=_SENS.mjSENS_FRAMEPOS,
@@ -209,7 +211,7 @@ def add_exact_contact(spec: mujoco.MjSpec, elements: PlayElements, clearance: Cl
     """
     from clearance.contact_plugin.attributes import add_for_clearance
 
-    ecc = _eccentricity_sensor(spec, elements)
+    ecc = add_eccentricity_sensor(spec, elements)
     name = exact_contact_name(elements.hinge)
     add_for_clearance(
         spec, clearance, name=name, journal_site=elements.journal_site, bearing_site=elements.bearing_site

@@ -34,6 +34,7 @@ from clearance.retrofit.loop import Pin, add_pin, connect_frame, pin_insertion_j
 from clearance.retrofit.masses import FROZEN_NOTE, Inertial, PointMassSplit, check_masses, freeze_inertials
 from clearance.retrofit.motion import Motion, twin_motion
 from clearance.retrofit.play import RadialPlay, RetrofitError, RetrofitOptions
+from clearance.retrofit.radial_stop import RadialStop, add_radial_stop, fit_radial_stop, stop_parameters
 from clearance.retrofit.selection import Hinge, compile_model, model_label, select_hinges
 from clearance.retrofit.sizing import (
     PlayMass,
@@ -79,6 +80,8 @@ class RetrofittedHinge:
             time step, integrator, impedance, contact mode).
         pin: a loop closure's pin (its share of the donor's mass, its connect's softness); None
             for a hinge.
+        stop: the step-limited radial stop at the robot's step (`RetrofitOptions.robot_step`);
+            None for a ring or the exact contact.
     """
 
     name: str
@@ -92,6 +95,7 @@ class RetrofittedHinge:
     contact: PlayContact
     model_options: ModelOptions
     pin: Pin | None = None
+    stop: RadialStop | None = None
 
 
 @dataclass
@@ -200,7 +204,8 @@ def retrofit(
     of_type("spec", spec, mujoco.MjSpec, "a mujoco.MjSpec (read a model file with mujoco.MjSpec.from_file(path))")
     of_type("options", options, (RetrofitOptions, type(None)), "a RetrofitOptions or None")
     options = options or RetrofitOptions()
-    exact = options.contact_mode is ContactMode.EXACT
+    robot = options.robot_step is not None
+    exact = options.contact_mode is ContactMode.EXACT and not robot
     clock = Clock()
     with clock("checks"):
         _check_plays(joints)
@@ -277,14 +282,15 @@ def retrofit(
                 joints[h.name].clearance,
                 motion.load_size(h.name),
                 masses[h.name],
-                segments=0 if exact else options.segments,  # the exact contact has no ring
+                segments=0 if exact or robot else options.segments,  # the exact contact and the stop have no ring
                 ripple_limit=options.ripple_limit,
                 flat=flat,
             )
     h_model = float(twin.opt.timestep)
-    step = options.timestep if options.timestep is not None else choose_time_step(sizings, h_model)
+    step = options.robot_step or options.timestep or choose_time_step(sizings, h_model)
     for name, s in sizings.items():
-        check_time_step(name, s, step)
+        if not robot:  # the step-limited stop is checked where it is fitted
+            check_time_step(name, s, step)
     pins = {n: soften_like_twin(work, twin, kinematic, n, share, step) for n, share in shares.items()}
     same_joints = list(enumerate(joint_ids(twin, kinematic, cmap.qpos)))
     kept = keep_constraint_softness(work, twin, kinematic, same_joints, step, skip=set(shares))
@@ -299,7 +305,11 @@ def retrofit(
             "which integrates with implicitfast (its explicit contact step is Euler's and implicitfast's alike)"
         )
     options_of = {h.name: _model_options(options, sizings[h.name], step, integrator) for h in hinges}
-    rings = {h.name: _ring(joints[h.name], sizings[h.name].segments, options_of[h.name]) for h in hinges if not exact}
+    rings = {
+        h.name: _ring(joints[h.name], sizings[h.name].segments, options_of[h.name])
+        for h in hinges
+        if not (exact or robot)
+    }
     chosen = options.segments is None  # the rule has tried every finer count already
     found = [
         ripple_miss(n, ring, sizings[n], options.ripple_limit, flat=flat, chosen=chosen) for n, ring in rings.items()
@@ -310,54 +320,44 @@ def retrofit(
     fit_misses: list[Miss] = []
     for h in hinges:
         play, sizing, model_options = joints[h.name], sizings[h.name], options_of[h.name]
-        if exact:
-            with clock("spec edit and compiles"):
-                add_exact_contact(work, elements[h.name], play.clearance)
-            contact = PlayContact(ContactParameters(sizing.stiffness, 0.0, source=EXACT_SOURCE))
-            done[h.name] = RetrofittedHinge(
-                h.name,
-                play,
-                h,
-                frames[h.name],
-                elements[h.name],
-                None,
-                masses[h.name],
-                sizing,
-                contact,
-                model_options,
-                pins.get(h.name),
-            )
-            continue
-        ring = rings[h.name]
+        ring, stop, added = rings.get(h.name), None, elements[h.name]
         with clock("contact parameters"):
-            contact = play_contact(play.clearance, ring, sizing, model_options, use_cache=options.use_cache)
-        if (miss := fit_miss(h.name, contact, ring, sizing)) is not None:
-            fit_misses.append(miss)
+            if robot:
+                stop = fit_radial_stop(
+                    h.name, play.clearance, sizing, timestep=step, integrator=int(twin.opt.integrator)
+                )
+                contact = PlayContact(stop_parameters(stop))
+            elif ring is None:
+                contact = PlayContact(ContactParameters(sizing.stiffness, 0.0, source=EXACT_SOURCE))
+            else:
+                contact = play_contact(play.clearance, ring, sizing, model_options, use_cache=options.use_cache)
+                if (miss := fit_miss(h.name, contact, ring, sizing)) is not None:
+                    fit_misses.append(miss)
         with clock("spec edit and compiles"):
-            added = add_bearing(
-                work,
-                elements[h.name],
-                work.body(elements[h.name].journal_body) if h.is_connect else work.joint(h.name).parent,
-                frames[h.name],
-                ring,
-                model_options,
-                play.clearance.friction,
-                cls,
-            )
-            a_hat = row_inverse_weight(kinematic, in_model[h.name].child_id, in_model[h.name].parent_id)
-            write_pair_contact(added.pairs, contact.parameters, a_hat, play.clearance.radial_clearance)
+            if stop is not None:
+                add_radial_stop(work, added, stop, cls)
+            elif ring is None:
+                add_exact_contact(work, added, play.clearance)
+            else:
+                journal = work.body(added.journal_body) if h.is_connect else work.joint(h.name).parent
+                pairs = add_bearing(
+                    work, added, journal, frames[h.name], ring, model_options, play.clearance.friction, cls
+                ).pairs
+                a_hat = row_inverse_weight(kinematic, in_model[h.name].child_id, in_model[h.name].parent_id)
+                write_pair_contact(pairs, contact.parameters, a_hat, play.clearance.radial_clearance)
         done[h.name] = RetrofittedHinge(
             h.name,
             play,
             h,
             frames[h.name],
-            elements[h.name],
+            added,
             ring,
             masses[h.name],
             sizing,
             contact,
             model_options,
             pins.get(h.name),
+            stop,
         )
     warnings += refuse_or_warn(fit_misses, options.accept_inaccurate)
     with clock("spec edit and compiles"):

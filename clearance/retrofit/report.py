@@ -109,6 +109,16 @@ def _added(h: RetrofittedHinge, r: Retrofit) -> list[str]:
         "the bearing (MuJoCo writes 6 digits: the ring's offsets from its centre keep them to 5e-8 m; checked after "
         "writing, within 1 % of c)",
     ]
+    if h.stop is not None:
+        return [
+            *head,
+            f"- stop: the spatial tendon `{el.sensors[1].removesuffix('_force')}` from `{el.bearing_site}` to "
+            f"`{el.journal_site}` (length |e|), limited to [0, {_g(h.stop.clearance)}] m: a circle-in-circle stop in "
+            f"MuJoCo's solver, solref {_vec(np.asarray(h.stop.stop.solref))}, solimp "
+            f"{_vec(np.asarray(h.stop.stop.solimp))}; no geoms, no pairs, no friction",
+            f"- sensors: `{el.sensors[0]}` (journal centre in the bearing frame), `{el.sensors[1]}` (the stop's force)",
+            "",
+        ]
     if h.ring is None:
         return [
             *head,
@@ -207,7 +217,24 @@ def _kept(r: Retrofit, asset_changes: list[str]) -> list[str]:
 
 
 def _accuracy(r: Retrofit) -> list[str]:
-    """What each ring states, and the rings kept although they miss it."""
+    """What each ring states, and the rings kept although they miss it (a robot-step stop: its fit and share of c)."""
+    stops = [h.stop for h in r.hinges.values() if h.stop is not None]
+    if stops:
+        return [
+            "Each stop's damping is fitted to the law's rebound at its effective mass and closing speed; its "
+            "deepest penetration is at most 20 % of c at that speed (else refused):",
+            "",
+            "| hinge | closing speed [m/s] | ζ | rebound error | impulse error | penetration / c | smallest c [µm] "
+            "| largest step [ms] |",
+            "|---|---|---|---|---|---|---|---|",
+            *[
+                f"| {s.hinge} | {_g(s.closing_speed, 3)} | {_g(s.stop.dampratio, 3)} | {s.stop.rebound_error:+.1%} "
+                f"| {s.stop.impulse_error:+.1%} | {s.penetration / s.clearance:.1%} | {_g(s.smallest_clearance * 1e6)} "
+                f"| {_g(s.largest_step * 1e3, 3)} |"
+                for s in stops
+            ],
+            "",
+        ]
     if r.options.contact_mode is ContactMode.EXACT:
         return []
     stated = (
@@ -246,8 +273,13 @@ def retrofit_report(r: Retrofit, *, source: str = "", command: str = "", asset_c
         "in its bearing or move along the axis, which the hinge still holds (a loop closure's pin moves in the plane "
         "normal to the axis of a hinge of its bodies; the connect holds it along that axis).",
         "",
-        f"Ring mode (portable MJCF, stock MuJoCo), contact {r.options.contact_mode.value}; "
-        f"{r.options.journal_geom.value} journal, {r.options.segment_geom.value} segments.",
+        (
+            "Robot-step mode (stock MuJoCo): each journal held within c by a tendon-limit stop at the robot's step "
+            "(clearance.retrofit.radial_stop): no ring, no friction, a linear stop far softer than the bearing."
+            if r.options.robot_step is not None
+            else f"Ring mode (portable MJCF, stock MuJoCo), contact {r.options.contact_mode.value}; "
+            f"{r.options.journal_geom.value} journal, {r.options.segment_geom.value} segments."
+        ),
         "",
         *_accuracy(r),
         "## Hinges given radial play",
@@ -274,7 +306,7 @@ def retrofit_report(r: Retrofit, *, source: str = "", command: str = "", asset_c
         f"{_g(r.timestep)} s (the model's own: {_g(h0)} s): "
         + (
             "given"
-            if r.options.timestep is not None
+            if r.options.timestep is not None or r.options.robot_step is not None
             else f"the largest 1, 2 or 5 x 10^k s with ω h <= {STEP_OMEGA_H} at every bearing, at most the "
             "model's own step"
         )
