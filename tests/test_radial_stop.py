@@ -18,6 +18,7 @@ import pytest
 from clearance.retrofit import RadialPlay, RetrofitError, RetrofitOptions, retrofit
 from clearance.retrofit.play_tendons import PlayKind, play_tendon_name
 from clearance.retrofit.radial_stop import radial_stop_force_name
+from clearance.retrofit.randomised_play import PlayDistribution, Uniform, randomise_play
 from clearance.retrofit.step_stop import MAX_PENETRATION
 
 C = 1e-3
@@ -114,3 +115,15 @@ def test_a_clearance_outside_the_region_is_refused_naming_what_is_usable():
     # each passes
     assert _retrofit("0 1 0", step=step, c=1.01 * smallest).hinges["pivot"].stop is not None
     assert _retrofit("0 1 0", step=0.99 * largest).hinges["pivot"].stop is not None
+
+
+def test_randomised_radial_stops_without_an_inverse_weight_take_a_size_only():
+    m = _retrofit("1 0 0", step=5e-4).model  # plane y-z: the tendon's inverse weight at qpos0 is 0
+    tendon = m.tendon(play_tendon_name("pivot", PlayKind.RADIAL)).id
+    assert m.tendon_invweight0[tendon] == 0.0
+    worlds = randomise_play(m, n_worlds=3, radial=PlayDistribution(size=Uniform(C, 2 * C)), seed=1)
+    sizes = [float(w.tendon_range[tendon, 1]) for w in worlds.models]
+    np.testing.assert_array_equal(sizes, worlds.size[:, 0])  # what was drawn is what each world holds
+    assert len(set(sizes)) == 3 and all(C <= s <= 2 * C for s in sizes)
+    with pytest.raises(RetrofitError, match="no inverse weight at qpos0"):
+        randomise_play(m, n_worlds=2, radial=PlayDistribution(stiffness=Uniform(1e4, 1e5)))

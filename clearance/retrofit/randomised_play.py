@@ -160,11 +160,14 @@ def stop_spring(model: mujoco.MjModel, tendon: int) -> tuple[float, float]:
 
     The mass-normalised spring and damper of its solref (direct or time-constant form, with
     MuJoCo's refsafe where it applies) at solimp's dmax, times the tendon's inverse weight's
-    reciprocal (module docstring); `randomise_play` writes them back as (-K Â, -B Â).
+    reciprocal (module docstring); `randomise_play` writes them back as (-K Â, -B Â). (nan, nan) where Â is 0:
+    a radial stop whose bearing plane is normal to the world's x axis (its size can still be randomised).
     """
     dmax = float(model.tendon_solimp_lim[tendon, 1])
     k, b = stiffness_damping(dmax, model.tendon_solref_lim[tendon], float(model.opt.timestep), refsafe(model))
     a = float(model.tendon_invweight0[tendon])
+    if a <= 0.0:  # a radial stop whose bearing plane is normal to x (a zero-length tendon points along x)
+        return math.nan, math.nan
     return k * dmax**2 / a, b * dmax / a
 
 
@@ -225,6 +228,15 @@ def _check_ranges(
             raise RetrofitError(
                 f"backlash size for hinge {t.hinge!r}: high {dist.size.high:g} rad is beyond {MAX_BACKLASH:.6g} rad "
                 "(10 degrees)"
+            )
+        if dist.stiffness is None and dist.damping is None:
+            continue  # the stop as compiled: its size does not change its stability
+        if t.invweight <= 0.0:
+            raise RetrofitError(
+                f"{t.kind.value} stop of hinge {t.hinge!r}: its tendon has no inverse weight at qpos0 (its bearing "
+                "plane is normal to the world's x axis, the direction MuJoCo gives a zero-length tendon), so its "
+                "stiffness and damping have no value in N/m and N s/m there; randomise its size only",
+                hinge=t.hinge,
             )
         k0, b0 = stop_spring(model, t.tendon)
         k = dist.stiffness.high if dist.stiffness is not None else k0
