@@ -40,9 +40,9 @@ from clearance.units import format_quantity as q
 if TYPE_CHECKING:
     import mujoco
 
-    from clearance.retrofit import Backlash, RadialPlay
+    from clearance.retrofit import RadialPlay
 
-__all__ = ["add_parser", "command", "JOINT_KEYS"]
+__all__ = ["add_parser", "command", "joint_values", "read_model", "JOINT_KEYS"]
 
 JOINT_KEYS = {
     "clearance_mm": "--clearance-mm",
@@ -62,9 +62,6 @@ journal's start in its bearing frame, [mm], defaults to the centre; ``bearing_le
 bearing's length L a cylindrical law uses, defaults to the bore 2 R_B; ``backlash_arcmin`` gives
 the hinge gear backlash of that half-width instead of radial play, with its stop's
 ``mesh_stiffness`` [N m/rad] and ``restitution``)."""
-
-BACKLASH_KEYS = ("backlash_arcmin", "mesh_stiffness", "restitution")
-"""The keys a --joint with backlash takes."""
 
 DESCRIPTION = (
     "Give hinges of any MuJoCo model radial play (each hinge gains two in-plane slides, its parent a ring "
@@ -219,10 +216,21 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "angle) or motor (the motor side, as an encoder on the motor); its jointactuatorfrc sensors follow the "
         "actuators to the motor side either way",
     )
+    p.add_argument(
+        "--robot-step",
+        type=positive(float, "--robot-step"),
+        default=None,
+        metavar="MS",
+        help="backlash at the step the robot runs at [ms] (e.g. 1 or 2): each band closed by the stiffest stop that "
+        "step represents (MuJoCo's soft limit, its spring time constant two steps, damping fitted to the exact "
+        "stop's rebound and impulse), the model and original.xml at that step, no plugin; refused, naming the "
+        "largest usable step and the smallest usable band, where the stop would sink more than 20 %% of the band "
+        "under the sizing motion (default: none, the calibrated stop at its own fine step)",
+    )
     p.set_defaults(run_command=command)
 
 
-def _joint_values(args: argparse.Namespace, text: str) -> tuple[str, dict[str, float]]:
+def joint_values(args: argparse.Namespace, text: str) -> tuple[str, dict[str, float]]:
     """(hinge name, its values in command-line units) from ``NAME[:key=value,...]``."""
     values = {
         key: float(getattr(args, flag[2:].replace("-", "_"))) if flag else 0.0 for key, flag in JOINT_KEYS.items()
@@ -264,7 +272,7 @@ def plays_from_args(args: argparse.Namespace) -> dict[str, RadialPlay]:
     gpa = UNITS["pressure"]["gpa"]
     plays: dict[str, RadialPlay] = {}
     for text in args.joint:
-        name, v = _joint_values(args, text)
+        name, v = joint_values(args, text)
         if name in plays:
             raise ValueError(f"--joint: hinge '{name}' is named twice")
         where = f"hinge '{name}'"
@@ -306,89 +314,7 @@ def plays_from_args(args: argparse.Namespace) -> dict[str, RadialPlay]:
     return plays
 
 
-def backlash_from_args(args: argparse.Namespace) -> dict[str, Backlash]:
-    """Hinge name -> `Backlash` where the --joint options name ``backlash_arcmin``; {} where none does.
-
-    Raises:
-        ValueError: some --joint name backlash and others not, a backlash joint with radial
-            play keys too, a half-width outside (0, 600] arc-minutes (10 degrees), a joint named twice.
-    """
-    from clearance.retrofit import MAX_BACKLASH, Backlash
-    from clearance.retrofit.play import DEFAULT_MESH_RESTITUTION, DEFAULT_MESH_STIFFNESS
-
-    cap = math.degrees(MAX_BACKLASH) * 60
-    given = [
-        (text, {item.partition("=")[0].strip() for item in text.partition(":")[2].split(",")}) for text in args.joint
-    ]
-    for text, keys in given:
-        if "mesh_stiffness" in keys and "backlash_arcmin" not in keys:
-            raise ValueError(
-                f"--joint {text!r}: mesh_stiffness is the stop of a backlash band; give backlash_arcmin too"
-            )
-    with_backlash = [(text, keys) for text, keys in given if "backlash_arcmin" in keys]
-    if not with_backlash:
-        return {}
-    if len(with_backlash) != len(args.joint):
-        other = next(text for text, keys in given if "backlash_arcmin" not in keys)
-        raise ValueError(
-            f"--joint {other!r}: backlash and radial play cannot be mixed in one command yet "
-            f"(--joint {with_backlash[0][0]!r} names backlash_arcmin)"
-        )
-    out: dict[str, Backlash] = {}
-    for text, keys in with_backlash:
-        name, v = _joint_values(args, text)
-        extra = sorted(keys - set(BACKLASH_KEYS))
-        if extra:
-            raise ValueError(
-                f"--joint {text!r}: a hinge with backlash takes no radial play keys (got {', '.join(extra)}); "
-                "backlash and radial play at one hinge are refused"
-            )
-        if name in out:
-            raise ValueError(f"--joint: hinge '{name}' is named twice")
-        b = v["backlash_arcmin"]
-        if not 0 < b <= cap:
-            raise ValueError(f"--joint {text!r}: backlash_arcmin must be in (0, {cap:g}] (got {b:g})")
-        stiffness = v["mesh_stiffness"] if "mesh_stiffness" in keys else DEFAULT_MESH_STIFFNESS
-        if not stiffness > 0:
-            raise ValueError(f"--joint {text!r}: mesh_stiffness must be > 0 [N m/rad] (got {stiffness:g})")
-        e = v["restitution"] if "restitution" in keys else DEFAULT_MESH_RESTITUTION
-        if not 0 < e <= 1:
-            raise ValueError(f"--joint {text!r}: restitution must be in (0, 1] (got {e:g})")
-        out[name] = Backlash.from_arcmin(
-            b, mesh_stiffness=stiffness, restitution=e, stop=args.backlash_stop, sensors=args.backlash_sensors
-        )
-    return out
-
-
-def _backlash_command(args: argparse.Namespace, joints: dict[str, Backlash]) -> int:
-    """``clearance retrofit`` with backlash at every named hinge; returns the exit status."""
-    from clearance.retrofit import add_backlash
-    from clearance.retrofit.output import write_backlash
-
-    out = check_folder(args.out, "--out")
-    spec = _read_model(Path(args.model))
-    with folder_lock(out):
-        try:
-            result = add_backlash(spec, joints)
-        except ValueError as err:
-            raise ValueError(f"{args.model}: {err}") from None
-        line = ["clearance retrofit", args.model, *[f"--joint {j}" for j in args.joint], f"--out {args.out}"]
-        if args.backlash_stop != "calibrated":
-            line.append(f"--backlash-stop {args.backlash_stop}")
-        if args.backlash_sensors != "load":
-            line.append(f"--backlash-sensors {args.backlash_sensors}")
-        with staged_outputs(out) as stage:  # every file, or none
-            source_dir = Path(args.model).resolve().parent
-            command = " ".join(line)
-            written = write_backlash(result, stage, source_dir=source_dir, source=str(args.model), command=command)
-        paths = {role: out / p.name for role, p in written.items()}
-    for note in result.notes:
-        print(note)
-    print("wrote " + ", ".join(str(p) for p in paths.values()))
-    return 0
-
-
-def _read_model(path: Path) -> mujoco.MjSpec:
+def read_model(path: Path) -> mujoco.MjSpec:
     """The model file's spec; a missing or unreadable file is refused naming it."""
     import mujoco
 
@@ -433,11 +359,17 @@ def _command_line(args: argparse.Namespace) -> str:
 def command(args: argparse.Namespace) -> int:
     """Run ``clearance retrofit``; returns the exit status (2: refused)."""
 
+    from clearance.cli.retrofit_backlash import backlash_command, backlash_from_args
     from clearance.retrofit import RetrofitOptions, SineControl, retrofit, write_retrofit
 
     backlash = backlash_from_args(args)
     if backlash:
-        return _backlash_command(args, backlash)
+        return backlash_command(args, backlash)
+    if args.robot_step is not None:
+        raise ValueError(
+            f"--robot-step {args.robot_step:g}: applies to backlash (--joint NAME:backlash_arcmin=B); radial play at "
+            "the robot's step is not offered by this command"
+        )
     plays = plays_from_args(args)
     options = RetrofitOptions(
         contact_mode=args.contact_mode,
@@ -452,7 +384,7 @@ def command(args: argparse.Namespace) -> int:
     )
     out = check_folder(args.out, "--out")
     path = Path(args.model)
-    spec = _read_model(path)
+    spec = read_model(path)
     check_steps(args.sizing_duration_s, spec.option.timestep, f"--sizing-duration-s {args.sizing_duration_s:g}")
     from clearance.cli.controls import check_sine_amplitude, read_controls
 

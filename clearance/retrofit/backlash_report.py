@@ -18,6 +18,8 @@ from clearance.contact_calibration.torsional_stop import GOAL, OMEGA_H, STOP_IMP
 from clearance.retrofit.backlash import BacklashHinge, BacklashRetrofit
 from clearance.retrofit.backlash_stop import POSE_SAMPLES
 from clearance.retrofit.play import DEFAULT_MESH_RESTITUTION, DEFAULT_MESH_STIFFNESS
+from clearance.retrofit.robot_step import ROBOT_STEP_STOP
+from clearance.retrofit.step_stop import STEP_SPAN
 
 __all__ = ["backlash_report"]
 
@@ -56,6 +58,14 @@ def _stop_rows(hinges: Sequence[BacklashHinge]) -> list[str]:
             lines.append(
                 f"| {h.name} | exact (the law, compiled plugin) | {law.mesh_stiffness:.6g} | {law.restitution:g} | "
                 f"{law.mesh_exponent:g} | {s.inertia:.4g} | {speed} | - | - | none (tendon unlimited) | - |"
+            )
+            continue
+        if s.kind == ROBOT_STEP_STOP and s.solref is not None:
+            law = h.backlash
+            lines.append(
+                f"| {h.name} | robot step (the step-limited limit, below) | {law.mesh_stiffness:.6g} | "
+                f"{law.restitution:g} | {law.mesh_exponent:g} | {s.inertia:.4g} | {speed} | - | - | "
+                f"({s.solref[0]:.6g}, {s.solref[1]:.6g}) | {1 / STEP_SPAN:g} |"
             )
             continue
         if fit is None or s.solref is None:

@@ -163,10 +163,35 @@ def write_backlash(
     src = Path(source_dir if source_dir is not None else (result.twin_spec.modelfiledir or "."))
     paths = {"model": out / MODEL_FILE, "original": out / TWIN_FILE, "report": out / REPORT_FILE}
     changes, _ = _write_models(result.spec, result.twin_spec, src, out, paths)
+    _exact_bands(paths["model"], {h.tendon: h.backlash.half_width for h in result.hinges.values()})
     paths["manifest"] = out / MANIFEST_FILE
     atomic_write_text(paths["manifest"], backlash_manifest_of(result).to_json())
     atomic_write_text(paths["report"], backlash_report(result, source=source, command=command, changes=changes))
     return paths
+
+
+def _exact_bands(path: Path, bands: dict[str, float]) -> None:
+    """Write each band's range at full precision in the model file ``path`` (tendon name -> b [rad]).
+
+    MuJoCo's MJCF writer keeps 6 significant digits; the band is the user's number, copied, so
+    it is written as the shortest text that reads back as the same double.
+
+    Raises:
+        RuntimeError: a band's tendon is not in the file, or the file no longer compiles.
+    """
+    import xml.etree.ElementTree as ET
+
+    tree = ET.parse(path)
+    found = {t.get("name"): t for t in tree.iter("fixed") if t.get("name") in bands}
+    for name, b in bands.items():
+        if name not in found:
+            raise RuntimeError(f"the written model {path} has no fixed tendon '{name}'")
+        found[name].set("range", f"{-b!r} {b!r}")
+    atomic_write_text(path, ET.tostring(tree.getroot(), encoding="unicode") + "\n")
+    try:
+        mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as err:
+        raise RuntimeError(f"the written model {path} does not compile: {err}") from None
 
 
 def manifest_of(result: Retrofit) -> RetrofitManifest:
