@@ -177,6 +177,32 @@ def prepare_miss(mech: Any, options: Any, repeat: int) -> Best:
     return _timed(lambda: prepare(mech, options), repeat, empty_cache)
 
 
+def sizing_alone(mech: Any, prepared: Any, repeat: int) -> dict[str, Best]:
+    """The sizing's cycle alone: as `prepare` takes it (a miss, a hit in the process) and as it took it
+    before the cache (the reactions over 181 times, `joint_reaction_vectors`, and the masses at 36 poses
+    on the compiled model, `cycle_effective_mass`, each solving the cycle's kinematics)."""
+    import numpy as np
+
+    from clearance.contact_calibration.effective_mass import cycle_effective_mass
+    from clearance.loads import joint_reaction_vectors
+    from clearance.run.cycle import CYCLE_TIMES, cycle_shape, scale_cycle
+    from clearance.run.cycle_cache import ideal_cycle
+
+    times = np.linspace(0.0, mech.drive_period, CYCLE_TIMES)
+
+    def before() -> None:
+        joint_reaction_vectors(mech, times)
+        cycle_effective_mass(prepared.model, prepared.built, mech)
+
+    return {
+        "sizing's cycle before the cache (reactions + masses on the compiled model)": _timed(before, repeat),
+        "sizing's cycle, computed (cycle_shape + scale_cycle)": _timed(
+            lambda: scale_cycle(cycle_shape(mech), mech), repeat
+        ),
+        "sizing's cycle, hit in the process (ideal_cycle)": _timed(lambda: ideal_cycle(mech), repeat),
+    }
+
+
 def warm(mech: Any, options: Any, duration: float, repeat: int) -> tuple[dict[str, Best], Any, Any]:
     """Warm-process timings of prepare (miss, file hit, memory hit) and simulate_prepared."""
     from clearance.run.cycle_cache import clear_memory
@@ -189,6 +215,7 @@ def warm(mech: Any, options: Any, duration: float, repeat: int) -> tuple[dict[st
     t["prepare, hit from the cache folder"] = _timed(lambda: prepare(mech, options), repeat, clear_memory)
     t["prepare, hit in the process"] = _timed(lambda: prepare(mech, options), repeat)
     prepared = prepare(mech, options)
+    t.update(sizing_alone(mech, prepared, repeat))
     result = simulate_prepared(prepared, duration=duration)
     t["simulate_prepared, every step read out"] = _timed(lambda: simulate_prepared(prepared, duration=duration), repeat)
     t["simulate_prepared, rows every 100 µs"] = _timed(
