@@ -51,7 +51,6 @@ import math
 import os
 import platform
 import sys
-import time
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -59,6 +58,7 @@ from typing import Any
 
 import numpy as np
 import scipy
+from _clock import clock, since  # benchmarks/_clock.py
 from _tables import write_keeping_reading  # benchmarks/_tables.py (scripts run from benchmarks/)
 
 from clearance.analysis.metrics.accuracy import first_impact, first_impact_errors
@@ -294,15 +294,6 @@ class Timing:
         return self.cpu / self.revolutions, self.wall / self.revolutions
 
 
-def _clock() -> tuple[float, float]:
-    return time.process_time(), time.perf_counter()
-
-
-def _since(start: tuple[float, float]) -> tuple[float, float]:
-    c, w = _clock()
-    return c - start[0], w - start[1]
-
-
 def _result(times: np.ndarray, penetration: np.ndarray, force: np.ndarray, **metadata: Any) -> SimulationResult:
     """A `SimulationResult` holding one clearance joint's penetration and force (what first impacts read).
 
@@ -345,12 +336,12 @@ def run_exudyn(
     solve, whole = Timing(revolutions=revolutions), Timing(revolutions=revolutions)
     model = None
     for _ in range(repeat):
-        start = _clock()
+        start = clock()
         model = build_exudyn(exu, mech, h=h, duration=duration, newton_rtol=newton_rtol)
-        mid = _clock()
+        mid = clock()
         exu.SolveDynamic(model.mbs, model.settings, solverType=exu.DynamicSolverType.GeneralizedAlpha, storeSolver=True)
-        solve.add(*_since(mid))
-        whole.add(*_since(start))
+        solve.add(*since(mid))
+        whole.add(*since(start))
     assert model is not None
     it = model.mbs.sys["dynamicSolver"].it
     steps = int(round(duration / h))
@@ -424,18 +415,18 @@ def run_ours(mech: Mechanism, *, mode: str, h: float, duration: float, repeat: i
         return OursRun(None, solve, whole, error=f"{type(exc).__name__}: {exc}")
     result = None
     for _ in range(repeat):
-        start = _clock()
+        start = clock()
         result = simulate(mech, duration=duration, options=options)
-        whole.add(*_since(start))
+        whole.add(*since(start))
     try:  # the stepping alone, on a model prepared beforehand
         from clearance.run.preparation import prepare
         from clearance.run.simulation import simulate_prepared
 
         prepared = prepare(mech, options)
         for _ in range(repeat):
-            start = _clock()
+            start = clock()
             simulate_prepared(prepared, duration=duration)
-            solve.add(*_since(start))
+            solve.add(*since(start))
     except (ImportError, TypeError) as exc:  # internals moved: only the whole call is timed
         print(f"exudyn_peer: our stepping is not timed alone ({type(exc).__name__}: {exc})", file=sys.stderr)
         solve = Timing(revolutions=revolutions)
@@ -579,10 +570,10 @@ def main(argv: list[str] | None = None) -> int:
     k, e_x = bearing_stiffness(clr), exudyn_restitution(clr)
 
     print("reference ...", flush=True)
-    start = _clock()
+    start = clock()
     ref = run_reference(mech, duration, output_interval=1e-6, rtol=1e-9)
     ref_time = Timing(revolutions=revs)
-    ref_time.add(*_since(start))
+    ref_time.add(*since(start))
     ref_fi = first_impact(ref, JOINT)
     if ref_fi is None:
         raise RuntimeError("the reference run has no impact: nothing to compare")

@@ -40,13 +40,15 @@ import shutil
 import subprocess
 import sys
 import tempfile
-import time
 from dataclasses import dataclass
 from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
+from _clock import clock, since  # benchmarks/_clock.py (scripts run from benchmarks/)
+
 HERE = Path(__file__).resolve().parent
+
 COLD_CHILD = "--cold-child"
 
 
@@ -57,31 +59,22 @@ def _scratch() -> str:
     return folder
 
 
-def _clock() -> tuple[float, float]:
-    return time.process_time(), time.perf_counter()
-
-
-def _since(start: tuple[float, float]) -> tuple[float, float]:
-    c, w = _clock()
-    return c - start[0], w - start[1]
-
-
 def cold_child(revolutions: float) -> None:
     """Run in a fresh interpreter: import, first prepare (a miss), first simulate; print CPU and wall [s] as JSON."""
     os.environ["CLEARANCE_CACHE_DIR"] = _scratch()
-    start = _clock()
+    start = clock()
     from clearance.builders import slider_crank
     from clearance.run.preparation import prepare
     from clearance.run.simulation import simulate_prepared
 
-    imported = _since(start)
+    imported = since(start)
     mech = slider_crank()
-    start = _clock()
+    start = clock()
     prepared = prepare(mech)
-    prep = _since(start)
-    start = _clock()
+    prep = since(start)
+    start = clock()
     simulate_prepared(prepared, duration=revolutions * mech.drive_period)
-    step = _since(start)
+    step = since(start)
     print(json.dumps({"import": imported, "prepare": prep, "simulate": step}))
 
 
@@ -101,9 +94,9 @@ def _timed(fn: Any, repeat: int, before: Any = None) -> Best:
     for _ in range(repeat):
         if before is not None:
             before()
-        start = _clock()
+        start = clock()
         fn()
-        best.add(_since(start))
+        best.add(since(start))
     return best
 
 
@@ -121,6 +114,7 @@ def bare_loops(prepared: Any, steps: int, repeat: int) -> dict[str, Best]:
     removed group by group (the sensors a run reads), and mujoco.rollout (the loop in C, sensors recorded)."""
     import mujoco
     import numpy as np
+    from _states import keyframe_state  # benchmarks/_states.py (imports mujoco: not before the cold child's clock)
     from mujoco import rollout
 
     def python_loop(model: Any) -> Best:
@@ -149,12 +143,9 @@ def bare_loops(prepared: Any, steps: int, repeat: int) -> dict[str, Best]:
         out["mj_step loop, sensors disabled"] = python_loop(model)
     finally:
         model.opt.disableflags = flags
+    state, ctrl = keyframe_state(model)
     data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, 0)
-    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
-    state = np.empty(mujoco.mj_stateSize(model, spec))
-    mujoco.mj_getState(model, data, state, spec)
-    control = np.asarray(data.ctrl, dtype=float).reshape(1, 1, -1)
+    control = ctrl.reshape(1, 1, -1)
     states = np.empty((1, steps, state.size))
     sensors = np.empty((1, steps, model.nsensordata))
 
@@ -246,7 +237,6 @@ def exudyn_side(mech: Any, revolutions: float, duration: float, h: float, repeat
         import exudyn  # noqa: F401  # only to know whether it is there
     except ImportError:
         return None
-    sys.path.insert(0, str(HERE))
     import exudyn_peer as peer
 
     exu = peer.import_exudyn("fast")
