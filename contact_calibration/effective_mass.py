@@ -19,6 +19,19 @@ Calibrated at the load-direction mass, the calibrated mode's long-run statistics
 scenario came much closer to the reference solver's (impacts per revolution +37 % against
 +80 %, 95th-percentile force +2.7 % against +16.9 %; benchmarks/speed_error.md).
 
+A slider with play (`clearance.mjcf.guide`) gets the mass its corners' contact rows see along
+the guide's normal n, from the corners' mobility A = R W Rᵀ (4 x 4), R_k = nᵀ J_k with J_k the
+translation Jacobian of corner k relative to the guide's material point under it. Where the
+ideal prismatic pair's load (normal force N, moment M) keeps both corners of the side it
+presses on in contact (|M|/L <= |N|/2: the slider lands and slides level on that side) each of
+the two rows sees 1 / ((A_aa + A_bb)/2 + A_ab), half the mass of the slider's level landing;
+otherwise one corner takes the impact, 1 / A_kk (the median of that side's two); with no load
+the median of the four corners alone. The minimum of a slider's range is the lightest corner
+alone over the cycle, whatever the load: a tilted landing meets it, and a row's stability is
+checked there. The two differ widely: on the published slider-crank of
+Flores, Leine and Glocker (2010), whose slider turns easily (J = 2.7e-6 kg m²), one corner alone
+sees 1.1 g where a level landing puts tens of grams on each corner.
+
 Poses come from the exact ideal kinematics (`clearance.kinematics.solve_kinematics`) over
 one drive period, mapped onto the model's qpos by Gauss–Newton on the body frames.
 The fit is made at the median over the cycle; the min–max range is kept as the valid range.
@@ -34,8 +47,10 @@ import numpy as np
 
 from clearance.kinematics import solve_kinematics
 from clearance.loads import joint_reaction_vectors
+from clearance.mjcf.guide import GuideGeometry, guide_site, slider_site
 from clearance.mjcf.spec import BuiltModel
 from clearance.model import DriveKind, Mechanism
+from clearance.translational import CORNERS
 
 __all__ = ["EffectiveMass", "LIGHT_LOAD", "cycle_effective_mass", "normal_effective_mass"]
 
@@ -118,8 +133,8 @@ def _constraint_rows(model: mujoco.MjModel, data: mujoco.MjData, mechanism: Mech
     return np.array(rows).reshape(-1, model.nv)
 
 
-def _mobility(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndarray) -> np.ndarray:
-    """A = J W Jᵀ (2, 2) [1/kg]: journal-to-bearing mobility in world xy with rows g held."""
+def _held_inverse_mass(model: mujoco.MjModel, data: mujoco.MjData, g: np.ndarray) -> np.ndarray:
+    """W = M⁻¹ − M⁻¹ Gᵀ (G M⁻¹ Gᵀ)⁺ G M⁻¹ (nv, nv): the inverse mass with the rows g held."""
     nv = model.nv
     minv = np.zeros((nv, nv))
     mujoco.mj_solveM(model, data, minv, np.eye(nv))
@@ -127,12 +142,61 @@ def _mobility(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndar
     if len(g):
         gm = g @ minv
         w = minv - gm.T @ np.linalg.pinv(gm @ g.T, rcond=1e-10) @ gm
+    return w
+
+
+def _mobility(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndarray) -> np.ndarray:
+    """A = J W Jᵀ (2, 2) [1/kg]: journal-to-bearing mobility in world xy with rows g held."""
+    nv = model.nv
+    w = _held_inverse_mass(model, data, g)
     jac = np.zeros((2, 3, nv))
     for k, site in enumerate((f"{joint}__journal", f"{joint}__bearing")):
         sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, site)
         mujoco.mj_jacSite(model, data, jac[k], None, sid)
     jrel = (jac[0] - jac[1])[:2]
     return jrel @ w @ jrel.T
+
+
+def _corner_mass(
+    model: mujoco.MjModel, data: mujoco.MjData, geometry: GuideGeometry, g: np.ndarray, load: np.ndarray | None
+) -> tuple[float, float]:
+    """(the mass a corner's contact row sees along the guide's normal, the lightest corner alone) [kg].
+
+    Args:
+        model, data: the model at the pose.
+        geometry: the slider.
+        g: the rows held (`_constraint_rows`).
+        load: (moment [N m], normal force [N]) of the ideal prismatic pair on the slider, or None
+            (light or no load: the median of the four corners alone).
+
+    See the module docstring.
+    """
+    w = _held_inverse_mass(model, data, g)
+    sid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, slider_site(geometry.joint))
+    gid = mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_SITE, guide_site(geometry.joint))
+    normal = data.site_xmat[gid].reshape(3, 3)[:, 1]
+    rot = data.site_xmat[sid].reshape(3, 3)
+    bodies = [int(model.site_bodyid[sid]), int(model.site_bodyid[gid])]
+    play = geometry.play
+    rows = np.zeros((len(CORNERS), model.nv))
+    for k, (fu, fn) in enumerate(CORNERS):
+        point = data.site_xpos[sid] + rot @ np.array([fu * play.slider_length, fn * play.slider_height, 0.0])
+        jac = np.zeros((2, 3, model.nv))
+        for b, body in enumerate(bodies):
+            mujoco.mj_jac(model, data, jac[b], None, point, body)
+        rows[k] = normal @ (jac[0] - jac[1])
+    a = rows @ w @ rows.T  # (4, 4) the corners' normal mobilities [1/kg]
+    alone = 1.0 / np.maximum(np.diag(a), 1e-300)
+    lightest = float(alone.min())
+    if load is None:
+        return float(np.median(alone)), lightest
+    moment, force = float(load[0]), float(load[1])
+    pair = [2, 3] if force > 0 else [0, 1]  # the guide pushes the slider towards +n from its -n line
+    if abs(moment) / play.slider_length <= 0.5 * abs(force):
+        # both corners of that side carry the load: each row sees half the level landing's mass
+        level = 0.5 * (a[pair[0], pair[0]] + a[pair[1], pair[1]]) + a[pair[0], pair[1]]
+        return 1.0 / max(float(level), 1e-300), lightest
+    return float(np.median(alone[pair])), lightest
 
 
 def _bearing_mass(model: mujoco.MjModel, data: mujoco.MjData, joint: str, g: np.ndarray, n_dir: int) -> float:
@@ -193,7 +257,8 @@ def cycle_effective_mass(
     lock_velocity_drives: bool = True,
     along_load: bool = True,
 ) -> dict[str, EffectiveMass]:
-    """Effective mass at every clearance joint over one drive period of the ideal cycle.
+    """Effective mass at every clearance joint and slider with play over one drive period of the
+    ideal cycle.
 
     Args:
         model: the compiled clearance model (``prepare(...).model``).
@@ -208,7 +273,8 @@ def cycle_effective_mass(
             False: the direction median at every pose.
 
     Returns:
-        joint name -> `EffectiveMass`.
+        joint name -> `EffectiveMass` (a slider's: its corners' rows along the guide's normal, its
+        minimum the lightest corner alone over the cycle).
 
     Raises:
         RuntimeError: a cycle pose cannot be reproduced in the model's coordinates.
@@ -220,7 +286,8 @@ def cycle_effective_mass(
     bids = [mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, n) for n in names]
     data = mujoco.MjData(model)
     data.qpos[:] = model.qpos0
-    out = {j: np.zeros(n_poses) for j in built.rings}
+    out = {j: np.zeros(n_poses) for j in (*built.rings, *built.guides)}
+    lightest = {j: np.zeros(n_poses) for j in built.guides}
     loads = joint_reaction_vectors(mechanism, times, kinematics=kin)[0] if along_load else {}
     sizes = {j: np.hypot(v[:, 0], v[:, 1]) for j, v in loads.items()}
     light = {j: LIGHT_LOAD * float(np.max(v)) for j, v in sizes.items()}
@@ -237,4 +304,9 @@ def cycle_effective_mass(
                 out[j][i] = 1.0 / max(float(n @ _mobility(model, data, j, g) @ n), 1e-300)
             else:
                 out[j][i] = _bearing_mass(model, data, j, g, n_dir)
-    return {j: EffectiveMass(float(np.median(v)), float(v.min()), float(v.max()), times, v) for j, v in out.items()}
+        for j, geometry in built.guides.items():
+            load = loads[j][i] if j in loads and sizes[j][i] > light[j] else None
+            out[j][i], lightest[j][i] = _corner_mass(model, data, geometry, g, load)
+    # a slider's rows range down to its lightest corner alone, whatever the load (the stability check's mass)
+    low = {j: float(min(v.min(), lightest[j].min() if j in lightest else np.inf)) for j, v in out.items()}
+    return {j: EffectiveMass(float(np.median(v)), low[j], float(v.max()), times, v) for j, v in out.items()}

@@ -38,7 +38,7 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING
 
@@ -72,6 +72,8 @@ __all__ = [
     "check_stability",
     "fit_contact",
     "fit_stages",
+    "fit_speeds",
+    "fitted_result",
     "speed_rows",
 ]
 
@@ -520,11 +522,7 @@ def fit_contact(
         ValueError: bad arguments (mass, speeds) or an unsupported law.
     """
     t0 = time.perf_counter()
-    if not (math.isfinite(mass) and mass > 0):
-        raise ValueError(f"mass must be positive and finite (got {mass!r} kg)")
-    speeds = np.sort(np.asarray(speeds, dtype=float))
-    if speeds.ndim != 1 or len(speeds) < 2 or not np.all(np.isfinite(speeds) & (speeds > 0)):
-        raise ValueError(f"speeds must be >= 2 positive finite values [m/s] (got {speeds!r})")
+    speeds = fit_speeds(mass, speeds)
     if directions is None:
         directions = np.array(DEFAULT_DIRECTIONS) * 2 * math.pi / ring.segments
     directions = np.asarray(directions, dtype=float)
@@ -542,6 +540,61 @@ def fit_contact(
     err, _, _ = evaluate(clearance, ring, options, params, mass=mass, speeds=speeds, directions=directions, refs=refs)
     dmax = max_penetration if max_penetration is not None else 4 * refs[-1].max_penetration
     stab = check_stability(ring, params, mass=mass, timestep=options.timestep, max_penetration=dmax)
+    solimp = "(d*(1-eps), d, c, 0.5, 1), eps = impedance_rise" if params.impedance_rise > 0 else None
+    return fitted_result(
+        params,
+        start,
+        mass=mass,
+        mass_range=mass_range,
+        options=options,
+        speeds=speeds,
+        directions=directions,
+        rows=speed_rows(speeds, err, refs),
+        stability=stab,
+        nfev=nfev,
+        started=t0,
+        meta={"law": clearance.law.value, "optimizer": "least_squares: " + "; ".join(messages)}
+        | ({"solimp": solimp} if solimp else {}),
+    )
+
+
+def fit_speeds(mass: float, speeds: np.ndarray) -> np.ndarray:
+    """A fit's impact speeds, sorted, once ``mass`` and ``speeds`` are checked.
+
+    Args:
+        mass: the calibration mass [kg].
+        speeds: (n_v,) impact speeds [m/s].
+
+    Raises:
+        ValueError: a mass that is not positive and finite, or fewer than two speeds or one that
+            is not positive and finite.
+    """
+    if not (math.isfinite(mass) and mass > 0):
+        raise ValueError(f"mass must be positive and finite (got {mass!r} kg)")
+    out = np.sort(np.asarray(speeds, dtype=float))
+    if out.ndim != 1 or len(out) < 2 or not np.all(np.isfinite(out) & (out > 0)):
+        raise ValueError(f"speeds must be >= 2 positive finite values [m/s] (got {out!r})")
+    return out
+
+
+def fitted_result(
+    params: ContactParameters,
+    start: ContactParameters,
+    *,
+    mass: float,
+    mass_range: tuple[float, float] | None,
+    options: ModelOptions,
+    speeds: np.ndarray,
+    directions: np.ndarray,
+    rows: tuple[SpeedRow, ...],
+    stability: Stability,
+    nfev: int,
+    started: float,
+    meta: Mapping[str, object],
+) -> CalibrationResult:
+    """A fit's `CalibrationResult`: its inputs, accuracy rows and stability, the time since
+    ``started`` (`time.perf_counter`), and ``meta`` over the fields every fit records (MuJoCo's
+    version, the emission, the impedance, the fit version and the residuals' goals)."""
     return CalibrationResult(
         parameters=params,
         initial=start,
@@ -550,20 +603,17 @@ def fit_contact(
         timestep=options.timestep,
         speeds=tuple(float(v) for v in speeds),
         directions=tuple(float(d) for d in directions),
-        rows=speed_rows(speeds, err, refs),
-        stability=stab,
+        rows=rows,
+        stability=stability,
         nfev=nfev,
-        wall_time=time.perf_counter() - t0,
+        wall_time=time.perf_counter() - started,
         meta={
             "mujoco": mujoco.__version__,
-            "law": clearance.law.value,
             "solref_mode": "direct (-k*A_hat, -b*A_hat)",
-            "solimp": "(d*(1-eps), d, c, 0.5, 1), eps = impedance_rise"
-            if params.impedance_rise > 0
-            else "(d, d, 0.001, 0.5, 2) as built",
+            "solimp": "(d, d, 0.001, 0.5, 2) as built",
             "impedance": options.impedance,
             "fit_version": FIT_VERSION,
             "residual_scale": GOALS,
-            "optimizer": "least_squares: " + "; ".join(messages),
-        },
+        }
+        | dict(meta),
     )

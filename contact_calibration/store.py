@@ -50,6 +50,7 @@ __all__ = [
     "CalibrationCacheWarning",
     "cache_dir",
     "calibration_key",
+    "fit_key",
     "calibration_path",
     "load_calibration",
     "save_calibration",
@@ -135,25 +136,39 @@ def calibration_key(
     mat = lambda m: [float(m.youngs_modulus), float(m.poisson_ratio)]  # noqa: E731
     # the bearing length enters a cylindrical law's force only: other keys (and files) stay as they were
     length = {"bearing_length": bearing_length(clearance)} if clearance.law in CYLINDRICAL_LAWS else {}
-    return length | {
-        "bearing_radius": float(clearance.bearing_radius),
-        "radial_clearance": float(clearance.radial_clearance),
-        "bearing_material": mat(clearance.bearing_material),
-        "journal_material": mat(clearance.journal_material),
-        "law": clearance.law.value,
-        "restitution": float(clearance.restitution),
-        "friction": float(clearance.friction),
+    return (
+        length
+        | {
+            "bearing_radius": float(clearance.bearing_radius),
+            "radial_clearance": float(clearance.radial_clearance),
+            "bearing_material": mat(clearance.bearing_material),
+            "journal_material": mat(clearance.journal_material),
+            "law": clearance.law.value,
+            "restitution": float(clearance.restitution),
+            "friction": float(clearance.friction),
+            "segments": int(ring.segments),
+            "segment_radius": float(ring.segment_radius),
+            "contacts_per_pair": int(ring.contacts_per_pair),
+            "journal_geom": options.journal_geom.value,
+            "segment_geom": options.segment_geom.value,
+        }
+        | fit_key(options, mass=mass, mass_range=mass_range, speeds=speeds)
+    )
+
+
+def fit_key(
+    options: ModelOptions, *, mass: float, mass_range: tuple[float, float], speeds: np.ndarray
+) -> dict[str, Any]:
+    """The part of a calibration key every fit shares: the mass and its range (rounded to
+    `MASS_DIGITS` significant figures), the speeds, the step, integrator and impedance, MuJoCo's
+    version and the fit's (`calibration_key`)."""
+    return {
         "effective_mass": _round_sig(mass),
         "mass_range": [_round_sig(x) for x in mass_range],
         "speeds": [float(v) for v in speeds],
         "timestep": float(options.timestep),
         "integrator": options.integrator,
         "impedance": float(options.impedance),
-        "segments": int(ring.segments),
-        "segment_radius": float(ring.segment_radius),
-        "contacts_per_pair": int(ring.contacts_per_pair),
-        "journal_geom": options.journal_geom.value,
-        "segment_geom": options.segment_geom.value,
         "mujoco": mujoco.__version__,
         "fit_version": FIT_VERSION,
     }

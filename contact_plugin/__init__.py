@@ -63,6 +63,7 @@ LIBRARY_FILE = "libclearance_journal_bearing" + {"darwin": ".dylib", "win32": ".
 
 _lock = threading.Lock()
 _loaded: Path | None = None
+_HERE = Path(__file__).resolve().parent  # resolved once: a preparation asks for the library several times
 
 
 class PluginUnavailableError(RuntimeError):
@@ -86,7 +87,7 @@ def library_path() -> Path | None:
     Returns:
         The library next to this module (an editable install builds it there too), or None.
     """
-    path = Path(__file__).resolve().parent / LIBRARY_FILE
+    path = _HERE / LIBRARY_FILE
     return path if path.is_file() else None
 
 

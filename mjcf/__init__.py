@@ -16,7 +16,8 @@ from clearance.mjcf.contact import (
     initial_velocity,
     row_inverse_weight,
 )
-from clearance.mjcf.spec import BuiltModel, build_spec, refuse_translational_clearance, ring_geometry
+from clearance.mjcf.guide import GuideGeometry
+from clearance.mjcf.spec import BuiltModel, build_spec, ring_geometry
 from clearance.mjcf.tree import BodyTree, body_tree
 
 __all__ = [
@@ -31,7 +32,7 @@ __all__ = [
     "row_inverse_weight",
     "BuiltModel",
     "build_spec",
-    "refuse_translational_clearance",
+    "GuideGeometry",
     "ring_geometry",
     "BodyTree",
     "body_tree",

@@ -1,4 +1,5 @@
-"""Contact parameters into a compiled model, and the effective mass at each bearing.
+"""Contact parameters into a compiled model (ring pairs, a slider's corner pairs), and the
+effective mass at each bearing.
 
 MuJoCo's direct-mode solref ``(-S, -D)`` with a small constant impedance acts as a plain
 spring-damper of physical stiffness S / A_hat and damping D / A_hat per contact row, where
@@ -18,11 +19,15 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
+from clearance.mjcf.guide import GuideGeometry, corner_pair_name
 from clearance.mjcf.spec import BuiltModel
 from clearance.options import ContactParameters
+from clearance.translational import CORNERS
 
 __all__ = [
     "apply_contact",
+    "apply_corner_contact",
+    "guide_inverse_weight",
     "row_solimp",
     "row_inverse_weight",
     "effective_masses",
@@ -82,6 +87,31 @@ def apply_contact(built: BuiltModel, model: mujoco.MjModel, params: dict[str, Co
             if solimp is not None:
                 model.pair_solimp[pid] = solimp
                 pairs[name].solimp = solimp
+
+
+def guide_inverse_weight(model: mujoco.MjModel, geometry: GuideGeometry) -> float:
+    """Â of a slider corner's contact rows [1/kg]: the slider's and the guide's translational inverse weights."""
+    bodies = (geometry.slider_body, geometry.guide_body)
+    ids = [max(mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, b), 0) for b in bodies]
+    return float(sum(model.body_invweight0[i, 0] for i in ids))
+
+
+def apply_corner_contact(
+    spec: mujoco.MjSpec, model: mujoco.MjModel, geometry: GuideGeometry, params: ContactParameters
+) -> None:
+    """Write a slider's per-corner stiffness and damping into its four pairs, as `apply_contact`
+    does a ring's: solref (-k Â, -b Â), Â = `guide_inverse_weight` (the pairs keep their small
+    constant impedance, so each row is the spring-damper k [N/m], b [N s/m]).
+
+    Updates the compiled ``model`` in place and ``spec`` (for MJCF output).
+    """
+    a_hat = guide_inverse_weight(model, geometry)
+    solref = [-params.stiffness * a_hat, -params.damping * a_hat]
+    pairs = {p.name: p for p in spec.pairs}
+    for k in range(len(CORNERS)):
+        name = corner_pair_name(geometry.joint, k)
+        model.pair_solref[mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_PAIR, name)] = solref
+        pairs[name].solref = solref
 
 
 def effective_masses(model: mujoco.MjModel, built: BuiltModel) -> dict[str, float]:

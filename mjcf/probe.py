@@ -14,7 +14,33 @@ from clearance.mjcf.bearing import RingGeometry
 from clearance.mjcf.bearing_geoms import Placement, add_journal_and_bearing
 from clearance.options import ContactParameters, ModelOptions
 
-__all__ = ["ring_scene", "static_ring_force", "measured_ripple"]
+__all__ = ["probe_spec", "ring_scene", "static_ring_force", "measured_ripple"]
+
+
+def probe_spec(
+    name: str, body_name: str, timestep: float, *, mass: float, axes: tuple[str, ...]
+) -> tuple[mujoco.MjSpec, mujoco.MjsBody]:
+    """An empty probe scene and its one body: implicitfast at ``timestep`` [s], no gravity,
+    elliptic cones, no auto-reset; the body of ``mass`` [kg] (a tiny explicit inertia) slides
+    along each of ``axes`` (of "x", "y"), a slide joint named like its axis.
+
+    Returns:
+        (the spec, the body).
+    """
+    spec = mujoco.MjSpec()
+    spec.modelname = name
+    spec.option.timestep = timestep
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.gravity = [0, 0, 0]
+    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
+    body = spec.worldbody.add_body(name=body_name)
+    body.mass = mass
+    body.inertia = [1e-6, 1e-6, 1e-6]
+    body.explicitinertial = True
+    for axis in axes:
+        body.add_joint(name=axis, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[float(axis == "x"), float(axis == "y"), 0])
+    return spec, body
 
 
 def ring_scene(
@@ -29,19 +55,7 @@ def ring_scene(
 
     The contact pairs get ``params`` in physical units (S = k A_hat, D = b A_hat).
     """
-    spec = mujoco.MjSpec()
-    spec.modelname = "ring_probe"
-    spec.option.timestep = options.timestep
-    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
-    spec.option.gravity = [0, 0, 0]
-    spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC
-    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
-    body = spec.worldbody.add_body(name="journal")
-    body.mass = mass
-    body.inertia = [1e-6, 1e-6, 1e-6]
-    body.explicitinertial = True
-    body.add_joint(name="x", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[1, 0, 0])
-    body.add_joint(name="y", type=mujoco.mjtJoint.mjJNT_SLIDE, axis=[0, 1, 0])
+    spec, body = probe_spec("ring_probe", "journal", options.timestep, mass=mass, axes=("x", "y"))
     centre = Placement((0.0, 0.0, 0.0))
     add_journal_and_bearing(spec, body, spec.worldbody, "ring", centre, centre, ring, options, friction)
     model = spec.compile()

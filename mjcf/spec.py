@@ -4,7 +4,8 @@ The body tree is built at the assembled t = 0 pose, so qpos0 is that pose; a key
 ``initial`` stores the ideal-mechanism velocities and the drive controls. Every body moves
 in the x-y plane through hinge-z and slide joints only. Inertials are explicit (geoms add no
 mass). Collisions happen only through explicit `<pair>` elements between each journal and
-its own bearing segments; every geom has contype = conaffinity = 0.
+its own bearing segments (and each slider corner and its guide plate,
+`clearance.mjcf.guide`); every geom has contype = conaffinity = 0.
 
 Sensor names (read by `clearance.simulate`):
   ``<link>__pos``, ``<link>__xaxis``: link (body) frame origin and x axis (world);
@@ -12,6 +13,7 @@ Sensor names (read by `clearance.simulate`):
   ``<joint>__jvel``, ``<joint>__bvel``, ``<joint>__bangvel``, ``<joint>__bxaxis``: world
   velocities of journal and bearing centres, bearing angular velocity and x axis;
   ``<joint>__force``: net contact force between bearing and journal bodies (world);
+  a slider with play: the sensors of `clearance.mjcf.guide.add_slider_sensors`;
   ``<output>__pos``, ``__vel``, ``__acc`` (point outputs) or ``__angvel``, ``__angacc``;
   ``<drive>__angle``, ``__speed``, ``__torque``; ``<cut>__closure`` for ideal cuts;
   ``<joint>__reaction``: for every tree joint, the force its parent body exerts on the child
@@ -23,7 +25,7 @@ Sensor names (read by `clearance.simulate`):
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
@@ -37,6 +39,7 @@ from clearance.mjcf.bearing_geoms import (
     add_journal_and_bearing_visual,
 )
 from clearance.mjcf.bearing_geoms import z_rotation as _quat
+from clearance.mjcf.guide import GuideGeometry, add_play_dofs, add_slider_in_guide, add_slider_sensors
 from clearance.mjcf.tree import BodyTree, body_tree
 from clearance.model import DriveKind, Joint, JointType, Link, Mechanism, OutputKind
 from clearance.options import ContactMode, GeomType, ModelOptions
@@ -47,7 +50,6 @@ __all__ = [
     "drive_armature",
     "drive_gear",
     "ring_geometry",
-    "refuse_translational_clearance",
 ]
 
 _OBJ = mujoco.mjtObj
@@ -70,6 +72,8 @@ class BuiltModel:
         exact_contact: the compiled-contact family: clearance joints have sites and visual
             geoms only (no ring, no pairs, no contact sensor); their contact is added by the
             run as engine-plugin instances (`clearance.contact_plugin`).
+        guides: slider with play (prismatic joint name) -> its `GuideGeometry` (sites, and in
+            the ring modes corner spheres, plates and pairs; `clearance.mjcf.guide`).
     """
 
     spec: mujoco.MjSpec
@@ -82,19 +86,7 @@ class BuiltModel:
     qd0: np.ndarray
     link_order: tuple[str, ...] = ()
     exact_contact: bool = False
-
-
-def refuse_translational_clearance(mechanism: Mechanism) -> None:
-    """Refuse a mechanism whose slider has play in its guide: MuJoCo does not model it yet.
-
-    Raises:
-        ValueError: naming the joint and where such a mechanism runs.
-    """
-    for j in mechanism.translational_joints:
-        raise ValueError(
-            f"joint '{j.name}' of '{mechanism.name}' has a translational clearance: translational clearance "
-            "runs in the reference solver only so far (use 'clearance reference')"
-        )
+    guides: dict[str, GuideGeometry] = field(default_factory=dict)
 
 
 def ring_geometry(joint: Joint, segments: int, options: ModelOptions) -> RingGeometry:
@@ -150,7 +142,8 @@ def build_spec(
     """Build the MuJoCo spec of a mechanism.
 
     Args:
-        mechanism: the mechanism (its clearance joints get ring bearings).
+        mechanism: the mechanism (its clearance joints get ring bearings, its sliders with play
+            their guides: `clearance.mjcf.guide`).
         options: numerical options (geoms, time step, integrator, impedance).
         segments: clearance joint name -> segment count N.
 
@@ -160,10 +153,8 @@ def build_spec(
 
     Raises:
         AssemblyError: the mechanism cannot be assembled at t = 0.
-        ValueError: a loop cannot be cut (see `body_tree`); a slider with play
-            (`refuse_translational_clearance`).
+        ValueError: a loop cannot be cut (see `body_tree`).
     """
-    refuse_translational_clearance(mechanism)
     tree = body_tree(mechanism)
     q0 = assemble(mechanism, 0.0)
     qd0 = velocities(mechanism, q0, 0.0)
@@ -213,6 +204,8 @@ def build_spec(
             c, s = math.cos(pose[child][2]), math.sin(pose[child][2])
             ax = [c * world_axis[0] + s * world_axis[1], -s * world_axis[0] + c * world_axis[1], 0.0]
             body.add_joint(name=joint.name, type=mujoco.mjtJoint.mjJNT_SLIDE, axis=ax, pos=[anchor[0], anchor[1], 0])
+            if joint.translational_clearance is not None:
+                add_play_dofs(body, joint, ax, anchor)
         elif joint.clearance is None:
             body.add_joint(
                 name=joint.name, type=mujoco.mjtJoint.mjJNT_HINGE, axis=[0, 0, 1], pos=[anchor[0], anchor[1], 0]
@@ -297,6 +290,14 @@ def build_spec(
         )
         s.intprm[:3] = [2, 3, 1]  # data = force, reduce = netforce, num = 1
 
+    guides = {}
+    for j in mechanism.translational_joints:
+        offset = float(pose[j.link_b][2] - pose[j.link_a][2])
+        guides[j.name] = add_slider_in_guide(
+            spec, bodies, mechanism, j, offset=offset, portable=not exact, impedance=options.impedance
+        )
+        add_slider_sensors(spec, guides[j.name])
+
     _reaction_sensors(spec, bodies, tree, links, mechanism.ground)
 
     for n in names:
@@ -330,7 +331,7 @@ def build_spec(
         _sensor(spec, f"{d.name}__speed", _SENS.mjSENS_JOINTVEL, _OBJ.mjOBJ_JOINT, d.joint)
         _sensor(spec, f"{d.name}__torque", _SENS.mjSENS_ACTUATORFRC, _OBJ.mjOBJ_ACTUATOR, d.name)
 
-    return BuiltModel(spec, tree, rings, jbody, bbody, gears, q0, qd0, tuple(names), exact)
+    return BuiltModel(spec, tree, rings, jbody, bbody, gears, q0, qd0, tuple(names), exact, guides)
 
 
 def _reaction_sensors(

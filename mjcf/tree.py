@@ -2,11 +2,11 @@
 
 A spanning tree of the mechanism graph (links as nodes, joints as edges) becomes the body
 tree; the other joints are cuts. Preference when building the tree (Kruskal with weights):
-driven joints and prismatic pairs must be tree edges (MuJoCo cannot cut them), ideal
-revolute joints next, clearance joints last. So a clearance joint is a cut whenever the
-loops allow it (contact alone closes that loop), the fewest ideal `connect` equalities
-remain, and only clearance joints beyond the number of loops become tree edges with
-slide / slide / hinge freedom.
+driven joints and ideal prismatic pairs must be tree edges (MuJoCo cannot cut them), ideal
+revolute joints next, joints with play (a journal in its bearing, a slider in its guide) last.
+So a joint with play is a cut whenever the loops allow it (contact alone closes that loop),
+the fewest ideal `connect` equalities remain, and only joints with play beyond the number of
+loops become tree edges with planar freedom (slide / slide / hinge).
 """
 
 from __future__ import annotations
@@ -34,18 +34,18 @@ class BodyTree:
 
     @property
     def ideal_cuts(self) -> tuple[Joint, ...]:
-        """Cut joints without clearance (become `connect` equalities)."""
-        return tuple(j for j in self.cuts if j.clearance is None)
+        """Cut joints without play (become `connect` equalities)."""
+        return tuple(j for j in self.cuts if not j.has_play)
 
 
 def _weight(j: Joint, driven: set[str]) -> int:
     if j.name in driven:
         return 0
+    if j.has_play:
+        return 3
     if j.kind is JointType.PRISMATIC:
         return 1
-    if j.clearance is None:
-        return 2
-    return 3
+    return 2
 
 
 def body_tree(mechanism: Mechanism) -> BodyTree:
@@ -75,7 +75,7 @@ def body_tree(mechanism: Mechanism) -> BodyTree:
             root[a] = b
             tree_edges.append(j)
     for j in cuts:
-        if j.kind is JointType.PRISMATIC:
+        if j.kind is JointType.PRISMATIC and not j.has_play:
             raise ValueError(
                 f"joint '{j.name}': a prismatic pair closes a loop that no revolute joint can "
                 "cut; MuJoCo models need a revolute joint in every loop"

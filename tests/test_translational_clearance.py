@@ -112,19 +112,6 @@ def test_the_ideal_start_turns_the_free_crank_at_its_initial_speed() -> None:
     assert qd[2] == pytest.approx(150.0, rel=1e-12) and qd[5] == pytest.approx(-75.0, rel=1e-9)
 
 
-def test_mujoco_refuses_a_slider_with_play_in_one_line(capsys: pytest.CaptureFixture[str]) -> None:
-    from clearance.mjcf import build_spec
-    from clearance.options import ModelOptions
-
-    mech = slider_crank(clearance_at=("slider_guide",))
-    with pytest.raises(ValueError, match="runs in the reference solver only so far"):
-        build_spec(mech, ModelOptions(), {})
-    code, _, err = run_cli(["run", "--clearance-at", "slider_guide", "--duration-ms", "1"], capsys)
-    errors = [line for line in err.splitlines() if line.startswith("error:")]
-    assert code == 2 and "Traceback" not in err and len(errors) == 1  # (a warning may come before it)
-    assert "translational clearance runs in the reference solver only so far" in errors[0]
-
-
 def test_clearance_reference_runs_the_benchmark_scenario_and_reports_the_slider(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:

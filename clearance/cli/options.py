@@ -111,7 +111,7 @@ def add_scenario_args(p: argparse.ArgumentParser, *, numerics: bool = True, cont
         default=None,
         metavar="JOINT",
         help="joints with clearance (default: the builder's, rod_slider for the slider-crank); "
-        "a slider's prismatic joint (slider_guide) gets play in its guide (clearance reference only); "
+        "a slider's prismatic joint (slider_guide) gets play in its guide; "
         "give none for the ideal mechanism",
     )
     g.add_argument(
@@ -300,7 +300,7 @@ def check_clearance_at(joints: list[str] | None, mechanism: str, *, sliders: boo
     unknown = [j for j in joints if j not in clearable]
     if unknown:
         where = (
-            f" (a slider's play, at {', '.join(info.sliders)}, runs in 'clearance reference' only so far)"
+            f" (a slider's play, at {', '.join(info.sliders)}, runs in 'clearance run' and 'reference', not here)"
             if info.sliders and not sliders
             else ""
         )

@@ -96,10 +96,14 @@ def _run(args: argparse.Namespace, mech: Mechanism, options: ModelOptions, durat
     prepared = prepare(mech, options)
     ideal_prepared = prepare(mech.ideal_twin(), options)
     print(
-        f"{mech.name}: clearance at {[j.name for j in mech.clearance_joints]}, "
+        f"{mech.name}: clearance at {[j.name for j in mech.joints if j.has_play]}, "
         f"{format_quantity(duration, 's')} at h = {format_quantity(options.timestep, 's')}, "
         f"{options.contact_mode.value} contact"
-        + ("" if prepared.built.exact_contact else ", " + _segments(prepared.metadata["segments"]))
+        + (
+            ""
+            if prepared.built.exact_contact or not prepared.built.rings
+            else ", " + _segments(prepared.metadata["segments"])
+        )
     )
     for line in calibration_lines(prepared.metadata.get("contact", {}), started):
         print(line)

@@ -11,7 +11,8 @@ term                        source
 ``kinetic``                 MuJoCo's kinetic energy sensor: ½ v'Mv with M including the
                             armature (so the speed drives' flywheel is in it)
 ``gravity_potential``       MuJoCo's potential energy sensor: −Σ m g·x_com (and springs)
-``contact_potential``       Σ over compiled contacts of their sensor's ``potential_energy``;
+``contact_potential``       Σ over compiled contacts (journals, sliders' corners) of their
+                            sensor's ``potential_energy``;
                             0 in the ring modes, whose contact rows have no potential MuJoCo
                             reports: the energy a ring stores while pressed is inside
                             ``contact_work`` (the rows' work), so the balance still closes
@@ -41,6 +42,7 @@ import numpy as np
 
 from clearance.contact_plugin.attributes import sensor_offsets
 from clearance.contact_plugin.energy import energy_sensor_addresses, has_energy_meter
+from clearance.contact_plugin.slider_guide import slider_sensor_offsets
 from clearance.run.preparation import PreparedModel, exact_contact_name
 
 __all__ = ["read_energy"]
@@ -88,6 +90,10 @@ def read_energy(prepared: PreparedModel, times: np.ndarray, sens: np.ndarray) ->
     if prepared.built.exact_contact:
         for joint in prepared.built.rings:
             o = sensor_offsets(model, exact_contact_name(joint))
+            potential += sens[:, o["potential_energy"]]
+            dissipated += sens[:, o["dissipated_work"]]
+        for joint in prepared.built.guides:
+            o = slider_sensor_offsets(model, exact_contact_name(joint))
             potential += sens[:, o["potential_energy"]]
             dissipated += sens[:, o["dissipated_work"]]
     out["contact_potential"] = potential

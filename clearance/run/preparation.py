@@ -26,17 +26,19 @@ from clearance.contact_plugin import PLUGIN_NAME, is_available
 from clearance.contact_plugin import require as require_plugin
 from clearance.contact_plugin.attributes import add_for_clearance, require_compiled_law
 from clearance.contact_plugin.energy import add_energy_meter
-from clearance.loads import joint_reactions
 from clearance.mjcf import (
     BuiltModel,
     add_initial_keyframe,
     apply_contact,
     build_spec,
     choose_segments,
-    refuse_translational_clearance,
 )
-from clearance.model import CYLINDRICAL_LAWS, DriveKind, Joint, Mechanism
+from clearance.model import CYLINDRICAL_LAWS, ContactLaw, DriveKind, Joint, Mechanism
 from clearance.options import ContactMode, ContactParameters, GeomType, ModelOptions
+from clearance.run.cycle_cache import ideal_cycle
+from clearance.run.sizing import JointSizing as JointSizing
+from clearance.run.sizing import load_penetration, size_joint
+from clearance.run.slider_contact import add_slider_contacts, corner_loads, guide_metadata, slider_sizing
 
 if TYPE_CHECKING:
     from clearance.run.reactions import ReactionLayout
@@ -46,37 +48,6 @@ __all__ = ["JointSizing", "PreparedModel", "prepare", "initial_controls", "exact
 
 class TimeStepError(ValueError):
     """The time step is too large for a contact's stiffness (explicit stability limit)."""
-
-
-@dataclass(frozen=True)
-class JointSizing:
-    """Loads and sizes of one clearance joint.
-
-    Attributes:
-        stiffness: journal-bearing stiffness K [N/m^1.5].
-        median_load, peak_load: ideal-mechanism reaction force over one cycle [N].
-        typical_penetration: (median_load / K)^(2/3) [m].
-        impact_speed: sqrt(2 peak_load c / m_eff), the speed gained crossing the clearance
-            under the peak load [m/s].
-        effective_mass: mass seen along the contact normal [kg]: median over the ideal
-            cycle of the mass along the ideal joint's load (loop closures and velocity
-            drives held), as `clearance.contact_calibration.cycle_effective_mass` measures it.
-        effective_mass_range: (min, max) of that mass over the cycle [kg], the range a
-            calibration is valid for.
-        penetration_limit: divergence bound [m]: 4 x the Hertz penetration of an impact at
-            ``impact_speed``, at least 4 x that under the peak load.
-        segments: ring segment count N (0 for the exact contact, which has no ring).
-    """
-
-    stiffness: float
-    median_load: float
-    peak_load: float
-    typical_penetration: float
-    impact_speed: float
-    effective_mass: float
-    penetration_limit: float
-    segments: int
-    effective_mass_range: tuple[float, float] = (0.0, 0.0)
 
 
 @dataclass
@@ -102,18 +73,25 @@ class PreparedModel:
         return self.built.spec.to_xml()
 
 
-def _cycle_times(mechanism: Mechanism, n: int = 181) -> np.ndarray:
-    return np.linspace(0.0, mechanism.drive_period or 1.0, n)
-
-
 def _refuse_lubricated(mechanism: Mechanism, mode: ContactMode) -> None:
     """Refuse a lubricated joint, with the reason, in a mode that cannot carry its film (the rings).
 
     Raises:
         ValueError: a clearance joint of the mechanism carries a `Lubrication` and ``mode`` is a
-            ring mode.
+            ring mode; more than one joint is lubricated in the exact contact.
     """
     oiled = [j.name for j in mechanism.clearance_joints if j.require_clearance().lubrication is not None]
+    if len(oiled) > 1 and mode is ContactMode.EXACT:
+        # benchmarks/lubricated_bearing.md, "Two lubricated joints": each film's damping is taken in
+        # the step with its own joint's response only, so two films diverge (the slider-crank with
+        # both rod joints oiled within 0.09 ms at 3, 1 and 0.5 us; the press's A and C spike to
+        # 312 kN at 3 us against the reference's 27.5 N)
+        raise ValueError(
+            f"joints {oiled} are all lubricated, and the exact contact runs one lubricated joint per mechanism: "
+            "it takes each film's damping in the step with its own joint alone, and two films on one mechanism "
+            "diverge at any practical step; run it in the reference solver (clearance reference), or keep one "
+            "joint lubricated"
+        )
     if not oiled or mode is ContactMode.EXACT:
         return
     raise ValueError(
@@ -122,6 +100,35 @@ def _refuse_lubricated(mechanism: Mechanism, mode: ContactMode) -> None:
         "across the whole clearance from the journal's speed; run them with contact_mode 'exact' or the "
         "reference solver (clearance reference)"
     )
+
+
+def _refuse_slider(mechanism: Mechanism, mode: ContactMode) -> None:
+    """Refuse a slider with play whose law or friction its corners cannot take in ``mode``, with the reason.
+
+    Raises:
+        ValueError: a cylindrical law (a pin in a hole) on a slider's corners; the IMPACT law
+            (the run passes no c_max and d_max); friction in a ring mode (the portable corners).
+    """
+    for j in mechanism.translational_joints:
+        play = j.require_translational()
+        if play.law in CYLINDRICAL_LAWS:
+            raise ValueError(
+                f"joint '{j.name}': law '{play.law.value}' is a law of a pin in a hole; a slider's corners take the "
+                "point laws (hertz, lankarani_nikravesh, flores, ...)"
+            )
+        if play.law is ContactLaw.IMPACT:
+            raise ValueError(
+                f"joint '{j.name}': law 'impact' needs c_max and d_max, which contact_mode '{mode.value}' does not "
+                "take for a slider's corners; run it in the reference solver (clearance reference)"
+            )
+        if play.friction > 0 and mode is not ContactMode.EXACT:
+            raise ValueError(
+                f"joint '{j.name}': friction {play.friction:g} cannot run in contact_mode '{mode.value}' (a slider's "
+                "portable corners): MuJoCo's friction cone lifts a sliding contact off its line at about mu |v_t| "
+                "(0.1 m/s for mu = 0.01 at 10 m/s of sliding), so the slider bounces along its guide where it "
+                "slides on it; run it with contact_mode 'exact' (Ambrosio's friction), in the reference solver "
+                "(clearance reference), or without friction"
+            )
 
 
 def check_run_arguments(mechanism: object, options: object) -> None:
@@ -155,28 +162,29 @@ def prepare(
     Raises:
         AssemblyError: the mechanism cannot be assembled.
         TimeStepError: the time step is too large for some contact's stiffness.
-        ValueError: bad options; a slider with play (translational clearance runs in the
-            reference solver only so far).
+        ValueError: bad options; a slider with play whose law or friction its contact cannot take.
+        CalibrationStabilityError: a calibrated or nominal contact is unstable at the time step.
     """
     check_run_arguments(mechanism, options)
-    refuse_translational_clearance(mechanism)  # before any work: MuJoCo has no slider with play yet
     options = options or ModelOptions()
     cjoints = mechanism.clearance_joints
+    sliders = mechanism.translational_joints
+    slider_names = {j.name for j in sliders}
     exact = options.contact_mode is ContactMode.EXACT
     _refuse_lubricated(mechanism, options.contact_mode)
-    if exact and cjoints:
+    _refuse_slider(mechanism, options.contact_mode)
+    if exact and (cjoints or sliders):
         require_plugin()  # before any work: without the compiled plugin this mode cannot run
         for j in cjoints:
             require_compiled_law(j.require_clearance().law, j.name)
-    loads = joint_reactions(mechanism, _cycle_times(mechanism)) if cjoints else {}
+    # the ideal cycle's loads and bearings' effective masses, their pose-dependent parts cached per mechanism
+    cycle = ideal_cycle(mechanism) if cjoints or sliders else None
+    pairs = cycle.loads if cycle is not None else {}
+    loads = {name: np.hypot(v[:, 0], v[:, 1]) for name, v in pairs.items()}
     segs: dict[str, int] = {}
-    pre: dict[str, tuple[float, float, float, float]] = {}
     for j in cjoints:
         c = j.require_clearance()
-        K = bearing_stiffness(c)
-        f = loads[j.name]
-        fmed, fmax = float(np.median(f)), float(np.max(f))
-        dtyp = (max(fmed, 1e-3 * max(fmax, 1e-9)) / K) ** (2 / 3) if fmax > 0 else 1e-7
+        dtyp = load_penetration(loads[j.name], bearing_stiffness(c))[2]
         # the compiled exact contact has no ring: 0 segments
         segs[j.name] = (
             0
@@ -190,26 +198,34 @@ def prepare(
                 flat=options.segment_geom is GeomType.BOX,
             )
         )
-        pre[j.name] = (K, fmed, fmax, dtyp)
     built = build_spec(mechanism, options, segs)
     model = built.spec.compile()
-    masses = cycle_effective_mass(model, built, mechanism) if cjoints else {}
-    sizing: dict[str, JointSizing] = {}
-    for j in cjoints:
-        K, fmed, fmax, dtyp = pre[j.name]
-        m = masses[j.name].median
-        v = math.sqrt(2 * max(fmax, 1e-9) * j.require_clearance().radial_clearance / m)
-        d_imp = (5 * m * v**2 / (4 * K)) ** 0.4
-        lim = 4 * max(d_imp, (max(fmax, 1e-9) / K) ** (2 / 3))
-        sizing[j.name] = JointSizing(K, fmed, fmax, dtyp, v, m, lim, segs[j.name], masses[j.name].valid_range)
+    masses = dict(cycle.masses) if cycle is not None else {}
+    if sliders:  # a slider's corners' masses from the compiled guide (not cached)
+        masses |= {k: v for k, v in cycle_effective_mass(model, built, mechanism).items() if k in slider_names}
+    sizing = {
+        j.name: size_joint(
+            stiffness=bearing_stiffness(j.require_clearance()),
+            loads=loads[j.name],
+            clearance=j.require_clearance().radial_clearance,
+            mass=masses[j.name],
+            segments=segs[j.name],
+        )
+        for j in cjoints
+    }
+    sizing |= slider_sizing(mechanism, corner_loads(mechanism, pairs), masses)
+    for name, s in sizing.items():
         # before any calibration: a fit at an unstable step fails with a less useful message
-        _check_time_step(j.name, sizing[j.name], options.timestep)
+        lightest = s.effective_mass_range[0] if name in slider_names else s.effective_mass
+        _check_time_step(name, s, options.timestep, lightest)
     params = dict(contact or {})
+    slider_params = {k: params.pop(k) for k in sorted(slider_names) if k in params}
     if exact:
-        if params:
+        if params or slider_params:
             raise ValueError(
-                f"contact parameters were given for {sorted(params)}, but contact_mode 'exact' computes each "
-                "joint's own contact law and takes no ring parameters; use contact_mode 'nominal' or 'calibrated'"
+                f"contact parameters were given for {sorted(params | slider_params)}, but contact_mode 'exact' "
+                "computes each joint's own contact law and takes no ring parameters; use contact_mode 'nominal' or "
+                "'calibrated'"
             )
         contact_meta = {j.name: _add_exact_contact(built, j) for j in cjoints}
     else:
@@ -226,6 +242,8 @@ def prepare(
             }
             for k, p in params.items()
         }
+    contact_meta |= add_slider_contacts(built, model, mechanism, sizing, options, slider_params, exact_contact_name)
+    params |= slider_params
     add_initial_keyframe(built, model, initial_controls(mechanism))
     # the run's model carries the energy meter; the spec (what to_xml writes) stays portable
     run_spec = built.spec
@@ -242,6 +260,8 @@ def prepare(
         "contact_mode": options.contact_mode.value,
         "contact": contact_meta,
         "sizing": {k: vars(s) for k, s in sizing.items()},
+        "translational_joints": [j.name for j in sliders],
+        "guides": guide_metadata(mechanism),
         "stiffness_formula": "K = 4/(3(sigma_B+sigma_J)) sqrt(R_B R_J/(R_B-R_J)), sigma=(1-nu^2)/E",
     }
     return PreparedModel(mechanism, options, built, model, sizing, params, meta)
@@ -297,17 +317,18 @@ def _contact_for(joint: Joint, built: BuiltModel, sizing: JointSizing, options: 
     return nominal_parameters(joint.require_clearance(), ring, effective_mass=sizing.effective_mass)
 
 
-def _check_time_step(name: str, s: JointSizing, h: float) -> None:
-    """Explicit contact stability needs omega h < 2, omega = sqrt(k_t / m_eff) (docs/mujoco_notes.md)."""
+def _check_time_step(name: str, s: JointSizing, h: float, mass: float) -> None:
+    """Explicit contact stability needs omega h < 2, omega = sqrt(k_t / m) (docs/mujoco_notes.md), m the
+    effective mass [kg] (a slider's lightest corner alone)."""
     k_t = 1.5 * s.stiffness * math.sqrt(s.penetration_limit)
-    omega = contact_omega(s.stiffness, s.penetration_limit, s.effective_mass)
+    omega = contact_omega(s.stiffness, s.penetration_limit, mass)
     if omega * h >= 2.0:
         h_max = 2.0 / omega
         raise TimeStepError(
             f"time step {h:g} s is too large for the contact stiffness at joint '{name}': "
             f"omega*h = {omega * h:.2f} >= 2 at the largest expected penetration "
             f"({s.penetration_limit * 1e6:.1f} um, tangent stiffness {k_t:.3g} N/m, effective mass "
-            f"{s.effective_mass:.3g} kg), so the contact would blow up. Use a time step below "
+            f"{mass:.3g} kg), so the contact would blow up. Use a time step below "
             f"{h_max:.3g} s (largest stable for the contact spring; damping lowers it, so stay well below), "
             f"and below {0.1 / omega:.3g} s (omega*h <= 0.1) to resolve that deepest impact's force peak exactly."
         )

@@ -15,7 +15,10 @@ MuJoCo's forward dynamics computed every force of the step:
   FORCE sensors of the body and its children), less the ring contacts on that body; with several
   cuts the bodies' equations are solved together (least squares, exact when the cuts form a
   forest, as every spanning-tree cut set of a planar linkage does);
-* a clearance joint: its contact force (the run's ``contact_force``), turned into the world frame.
+* a clearance joint: its contact force (the run's ``contact_force``), turned into the world frame;
+  a slider with play likewise: its corners' net contact force on the slider (its link_b), which
+  stands in the layout where a journal's does (the slider as the journal, the guide as the
+  bearing).
 """
 
 from __future__ import annotations
@@ -58,7 +61,7 @@ class ReactionLayout:
         parent_joint: moving link -> the tree joint to its parent.
         tree: tree joints read from FORCE sensors (clearance tree edges excluded).
         clearance: clearance joint -> (journal link, bearing link, sign): sign = +1 when the
-            journal is the joint's link_b.
+            journal is the joint's link_b; a slider with play -> (slider, guide, +1).
         cuts: ideal cut joint names (connect equalities).
         bodies: links whose Newton equation gives the cut forces (touched by a cut).
         masses: (len(bodies),) their masses [kg].
@@ -120,6 +123,8 @@ def reaction_layout(
         assert jl is not None  # Mechanism resolves the journal side of every clearance
         bl = j.link_b if jl == j.link_a else j.link_a
         clearance[j.name] = (jl, bl, 1.0 if jl == j.link_b else -1.0)
+    for j in mechanism.translational_joints:
+        clearance[j.name] = (j.link_b, j.link_a, 1.0)
     tree = []
     for child, (_, jname) in parents.items():
         if jname in clearance:

@@ -3,7 +3,8 @@
 Sensor names are those written by `clearance.mjcf.spec`. With `mujoco.rollout`, sensor
 row i describes the state at t_i = i h (before step i is integrated) and state row i the state
 after it, at t_i + h. A model with the energy meter also gets its energy series
-(`clearance.run.energy`); every run gets its joint reactions (`clearance.run.reactions`).
+(`clearance.run.energy`); every run gets its joint reactions (`clearance.run.reactions`) and its
+sliders with play (`clearance.run.slider_readout`).
 
 Drive torque. A speed drive is a velocity actuator that implicitfast integrates implicitly:
 over step i it applies F(v_i) + dF/dv (v_{i+1} - v_i), the force at the step's end velocity,
@@ -24,6 +25,7 @@ from clearance.results import JointResult, SimulationResult
 from clearance.run.energy import read_energy
 from clearance.run.preparation import PreparedModel, exact_contact_name
 from clearance.run.reactions import reaction_layout, read_reactions, rotate
+from clearance.run.slider_readout import read_sliders
 
 __all__ = ["read_sensors", "sensor_slices"]
 
@@ -145,6 +147,8 @@ def read_sensors(
         pen = np.hypot(e[:, 0], e[:, 1]) - ring.radial_clearance
         joints[jname] = JointResult(e, erate, pen, force, film)
 
+    sliders, slider_world = read_sliders(prepared, get, sens)
+    journal_world |= slider_world  # a slider's contact force acts on it as a journal's does
     if prepared.reactions is None:
         tree = prepared.built.tree
         prepared.reactions = reaction_layout(
@@ -169,7 +173,9 @@ def read_sensors(
     else:
         closure = np.zeros(n)
     energy = read_energy(prepared, times, sens)
-    return SimulationResult(times, outputs, joints, angle, speed, torque, poses, closure, {}, energy, reactions)
+    return SimulationResult(
+        times, outputs, joints, angle, speed, torque, poses, closure, {}, energy, reactions, sliders=sliders
+    )
 
 
 def _drive_torque(

@@ -380,7 +380,7 @@ def _first_warning_step(
 def _remedy(prepared: PreparedModel) -> str:
     h = prepared.options.timestep
     smaller = f"use a smaller time step (now {h:g} s, try {h / 2:g} s)"
-    if prepared.built.exact_contact:
+    if prepared.built.exact_contact or not prepared.built.rings:
         return smaller
     return f"{smaller} or more bearing segments (ModelOptions(segments=...))"
 
@@ -422,21 +422,26 @@ def _first_bad(
 ) -> tuple[int, str | None, str, str] | None:
     """(row index, joint or None, reason, remedy) of a chunk's first bad row, or None.
 
-    Rows from the index on are dropped. A row is bad when its journal is beyond the
-    divergence bound (that joint is named) or its state or sensors are not finite (no
-    joint is named: the cause cannot be tied to one). State row i is after step i and
+    Rows from the index on are dropped. A row is bad when its journal, or a corner of its
+    slider, is beyond the divergence bound (that joint and the corner are named) or its state
+    or sensors are not finite (no joint is named: the cause cannot be tied to one). State row i is after step i and
     sensor row i before it, so a step that goes non-finite drops its own row. With
     ``warnings``, MuJoCo warnings the stepper could not place drop the whole chunk.
     """
     n = len(part.times)
     finite = np.isfinite(states[:n]).all(axis=1) & np.isfinite(sens[:n]).all(axis=1)
     first_nan = int(np.argmin(finite)) if not finite.all() else n
-    worst: tuple[int, str, float] | None = None  # (row, joint, penetration) of the first row beyond a bound
-    for name, jr in part.joints.items():
-        lim = prepared.sizing[name].penetration_limit
-        over = np.nonzero(jr.penetration > lim)[0]
+    worst: tuple[int, str, float, str] | None = None  # (row, joint, penetration, what) of the first row beyond
+    pens = [(name, jr.penetration, "the journal penetrated {} um into its bearing") for name, jr in part.joints.items()]
+    pens += [
+        (name, sr.corner_penetration[:, k], f"corner {k} of the slider penetrated {{}} um into its guide")
+        for name, sr in part.sliders.items()
+        for k in range(sr.corner_penetration.shape[1])
+    ]
+    for name, pen, what in pens:
+        over = np.nonzero(pen > prepared.sizing[name].penetration_limit)[0]
         if len(over) and (worst is None or over[0] < worst[0]):
-            worst = (int(over[0]), name, float(jr.penetration[over[0]]))
+            worst = (int(over[0]), name, float(pen[over[0]]), what)
     remedy = _remedy(prepared)
     if worst is not None and worst[0] <= first_nan:
         lim = prepared.sizing[worst[1]].penetration_limit
@@ -444,8 +449,8 @@ def _first_bad(
             worst[0],
             worst[1],
             (
-                f"the journal penetrated {worst[2] * 1e6:.3g} um into its bearing, beyond the bound "
-                f"{lim * 1e6:.3g} um (4 x the Hertz penetration of the expected hardest impact)"
+                f"{worst[3].format(f'{worst[2] * 1e6:.3g}')}, beyond the bound {lim * 1e6:.3g} um (4 x the Hertz "
+                "penetration of the expected hardest impact)"
             ),
             remedy,
         )
