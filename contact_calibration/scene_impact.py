@@ -122,13 +122,21 @@ def ring_gap(ring: RingGeometry, position: np.ndarray) -> np.ndarray:
 
 
 def onset_radius(ring: RingGeometry, direction: float) -> float:
-    """Journal-centre radius [m] at which first contact occurs along ``direction`` [rad]."""
+    """Journal-centre radius [m] at which first contact occurs along ``direction`` [rad].
+
+    In closed form: the journal centre r u touches segment i (centre s_i, |s_i| = rho) when
+    |r u - s_i| = a = R_J + r_s, first at r_i = s_i.u - sqrt(a^2 - (s_i x u)^2); the onset is the
+    smallest r_i over the segments the line meets in front of the centre (c along a segment's
+    own direction, where s_i.u = rho and rho - a = c).
+    """
+    s = segment_centres(ring)
     u = np.array([math.cos(direction), math.sin(direction)])
-    lo, hi = 0.5 * ring.radial_clearance, 2.0 * ring.radial_clearance
-    for _ in range(100):
-        mid = 0.5 * (lo + hi)
-        lo, hi = (mid, hi) if ring_gap(ring, mid * u) > 0 else (lo, mid)
-    return 0.5 * (lo + hi)
+    along = s @ u
+    across = s[:, 0] * u[1] - s[:, 1] * u[0]
+    a = ring.journal_radius + ring.segment_radius
+    disc = a * a - across * across
+    met = (disc >= 0.0) & (along > 0.0)
+    return float(np.min(along[met] - np.sqrt(disc[met])))
 
 
 def _peak(values: np.ndarray) -> tuple[float, int]:

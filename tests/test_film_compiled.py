@@ -124,3 +124,12 @@ def test_a_journal_driven_through_the_film_into_dry_contact_is_stable_at_the_def
     # measured: penetration 5.361 against 5.364 um, peak force +0.05 %; 2 % as the bound
     assert a.penetration.max() == pytest.approx(b.penetration.max(), rel=0.02)
     assert a.force_magnitude.max() == pytest.approx(b.force_magnitude.max(), rel=0.02)
+
+
+def test_two_lubricated_joints_are_refused_in_the_exact_contact_before_any_work() -> None:
+    # benchmarks/lubricated_bearing.md ("Two lubricated joints"): both rod joints oiled diverge within
+    # 0.09 ms at any step down to 0.5 us, so the run is refused, naming the joints and the remedy
+    text = SCENARIO.read_text()
+    mech = loads_scenario(text.replace('clearance_at = ["rod_slider"]', 'clearance_at = ["crank_rod", "rod_slider"]'))
+    with pytest.raises(ValueError, match=r"\['crank_rod', 'rod_slider'\] are all lubricated.*clearance reference"):
+        simulate(mech, duration=1e-4, options=ModelOptions())
