@@ -144,3 +144,14 @@ def test_memory_keeps_a_bounded_number_of_shapes(tmp_path, monkeypatch):
             dataclasses.replace(m, links=tuple(heavier if lk is link else lk for lk in m.links)), directory=tmp_path
         )
     assert len(cycle_cache._MEMORY) == 2
+
+
+def test_bearing_masses_beside_a_slider_with_play():
+    # the slider's rows are left free in the mobility, as its guide's contact leaves them in the model
+    m = slider_crank(clearance_at=("crank_rod", "rod_slider", "slider_guide"))
+    cycle = scale_cycle(cycle_shape(m), m)
+    built = build_spec(m, ModelOptions(contact_mode=ContactMode.EXACT), {j.name: 0 for j in m.clearance_joints})
+    masses = cycle_effective_mass(built.spec.compile(), built, m)
+    assert set(cycle.masses) == {"crank_rod", "rod_slider"}
+    for k, mass in cycle.masses.items():
+        assert np.allclose(mass.values, masses[k].values, rtol=AGREE, atol=0.0), k  # AGREE: as above
