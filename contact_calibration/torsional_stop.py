@@ -362,7 +362,9 @@ def fit_stop(
 
     def impacts(x: np.ndarray) -> np.ndarray:
         """(speed, phase, [peak, restitution]) of the scene with stiffness, damping exp(x)."""
-        model = stop_scene(j, b, stop_solref(math.exp(x[0]), math.exp(x[1]), 1.0 / j), h, integrator)
+        # a band at least stop_at's (1 rad): a narrow one (the zero-play check's 0.1') crossed in one step at a fast
+        # closing (UR5e's wrist, 1570 rad/s at 5e-7 s) reached its far stop before the impact separated
+        model = stop_scene(j, max(b, 1.0), stop_solref(math.exp(x[0]), math.exp(x[1]), 1.0 / j), h, integrator)
         return np.array([[scene_stop_impact(model, float(s), p, max_steps) for p in PHASES] for s in v])
 
     target = np.array([[r[0], r[1]] for r in refs])[:, None, :]

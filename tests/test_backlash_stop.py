@@ -207,3 +207,20 @@ def test_cli_refuses_a_bad_mesh_before_any_work(tmp_path, capsys, joint, expecte
     err = capsys.readouterr().err
     assert expected in err and err.count("\n") == 1 and "Traceback" not in err
     assert not out.exists()
+
+
+def test_a_narrow_band_closing_fast_fits_as_a_wide_one():
+    """The fit's scene is one impact on one stop: a band crossed in a step (UR5e's wrist at 0.1': 5.8e-5 rad
+    against ~1e-4 rad per step at 1e3 rad/s and 1e-7 s) must not reach its far stop before the impact separates."""
+    from clearance.contact_calibration.torsional_stop import MeshLaw, fit_stop, stop_speeds
+
+    law, inertia, step = MeshLaw(1e4, 0.8, 1.0), 1.3e-8, 1e-7
+    speeds = stop_speeds(1e3)
+    assert speeds[-1] * step > 2 * math.radians(0.1 / 60)  # the fastest closing crosses the narrow band in a step
+    narrow, wide = (
+        fit_stop(law, inertia=inertia, half_width=b, speeds=speeds, timestep=step)
+        for b in (math.radians(0.1 / 60), 1.0)
+    )
+    # the same scene but for where its stop sits: equal up to the rounding of the positions (b - q)
+    assert narrow.stiffness == pytest.approx(wide.stiffness, rel=1e-6)
+    assert narrow.damping == pytest.approx(wide.damping, rel=1e-6)
