@@ -36,6 +36,7 @@ from clearance.contact_calibration.effective_mass import LIGHT_LOAD, EffectiveMa
 from clearance.kinematics import ConstraintSystem, solve_kinematics
 from clearance.loads import generalized_inertial_forces
 from clearance.model import DriveKind, Mechanism
+from clearance.run.sizing import median
 
 __all__ = [
     "CYCLE_TIMES",
@@ -187,7 +188,7 @@ def _direction_median(mobility: np.ndarray) -> np.ndarray:
     ang = np.linspace(0, np.pi, _DIRECTIONS, endpoint=False)
     normals = np.stack([np.cos(ang), np.sin(ang)], axis=1)
     inv = np.einsum("di,nij,dj->nd", normals, mobility, normals)
-    return np.median(1.0 / np.maximum(inv, 1e-300), axis=1)
+    return median(1.0 / np.maximum(inv, 1e-300), axis=1)
 
 
 def scale_cycle(shape: CycleShape, mechanism: Mechanism) -> IdealCycle:
@@ -212,6 +213,6 @@ def scale_cycle(shape: CycleShape, mechanism: Mechanism) -> IdealCycle:
         along = 1.0 / np.maximum(np.einsum("ni,nij,nj->n", n, a, n), 1e-300)
         values = np.where(heavy, along, _direction_median(a))
         masses[name] = EffectiveMass(
-            float(np.median(values)), float(values.min()), float(values.max()), pose_times, values
+            float(median(values)), float(values.min()), float(values.max()), pose_times, values
         )
     return IdealCycle(times, loads, masses)
