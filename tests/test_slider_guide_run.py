@@ -244,6 +244,7 @@ def test_clearance_run_takes_a_slider_with_play(tmp_path: Path, capsys: pytest.C
     code, stdout, err = run_cli(argv, capsys)
     assert code == 0, err
     assert "clearance at ['slider_guide']" in stdout
+    assert "slider_guide, whole run: free" in stdout  # the slider's console line, as the reference prints it
     assert "## Slider in its guide: slider_guide" in (out / "report.md").read_text()
     res = SimulationResult.load(out / "result")
     assert res.sliders[JOINT].contact_case.max() == SliderContact.ONE_SIDE.value  # the first impact, level

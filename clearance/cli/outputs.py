@@ -25,6 +25,7 @@ __all__ = [
     "writing_outputs",
     "note_stop",
     "console_lines",
+    "slider_lines",
     "calibration_lines",
     "duration_from_args",
     "duration_source",
@@ -140,6 +141,8 @@ def write_outputs(
 
     for line in console_lines(mech, rows, reactions, films=film_summaries(result)):
         print(line)
+    for line in slider_lines(result):
+        print(line)
 
 
 def console_lines(
@@ -216,6 +219,22 @@ def console_lines(
                 f"{q(r.startup_window, 's')}, as the report gives it)"
             )
         lines.append(text)
+    return lines
+
+
+def slider_lines(result: SimulationResult) -> list[str]:
+    """One console line per slider with play: time in each contact case, largest tilt and force."""
+    from clearance.analysis.metrics.slider import slider_summary
+
+    q = format_quantity
+    lines = []
+    for joint, sr in result.sliders.items():
+        s = slider_summary(result.times, sr)
+        shares = ", ".join(f"{c.name.lower().replace('_', ' ')} {v:.1%}" for c, v in s.shares.items())
+        lines.append(
+            f"  {joint}, whole run: {shares} ({s.switches} switches); largest tilt {q(s.max_tilt, 'rad')}, "
+            f"peak corner force {q(s.peak_corner_force, 'N')}, max penetration {q(s.max_penetration, 'm')}"
+        )
     return lines
 
 

@@ -24,7 +24,6 @@ from clearance.cli.outputs import (
 )
 from clearance.cli.paths import folder_lock
 from clearance.model import Mechanism
-from clearance.results import SimulationResult
 from clearance.units import format_quantity
 
 __all__ = ["add_parser", "command"]
@@ -116,27 +115,9 @@ def _reference(args: argparse.Namespace, mech: Mechanism, duration: float, inter
         stopped = None if failed is None else str(failed)
         write_outputs(args, mech, result, ideal, stage, recording=recording, stopped=stopped)
     rrd = None if not args.rerun else Path(args.rerun).resolve()
-    for line in _slider_lines(result):
-        print(line)
     wall = format_quantity(result.metadata.get("wall_time_s", float("nan")), "s")
     print(f"  wall time {wall}; wrote {out}/" + ("" if rrd is None else f" and {rrd}"))
     if failed is not None:
         print(f"error: {failed}", file=sys.stderr)
         return 2
     return 0
-
-
-def _slider_lines(result: SimulationResult) -> list[str]:
-    """One console line per slider with play: time in each contact case, largest tilt and force."""
-    from clearance.analysis.metrics.slider import slider_summary
-    from clearance.units import format_quantity as q
-
-    lines = []
-    for joint, sr in result.sliders.items():
-        s = slider_summary(result.times, sr)
-        shares = ", ".join(f"{c.name.lower().replace('_', ' ')} {v:.1%}" for c, v in s.shares.items())
-        lines.append(
-            f"  {joint}, whole run: {shares} ({s.switches} switches); largest tilt {q(s.max_tilt, 'rad')}, "
-            f"peak corner force {q(s.peak_corner_force, 'N')}, max penetration {q(s.max_penetration, 'm')}"
-        )
-    return lines
