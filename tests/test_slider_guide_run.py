@@ -152,6 +152,18 @@ def test_a_run_in_chunks_is_the_run_in_one(flores: Mechanism, exact: SimulationR
 
 
 @needs_plugin
+def test_the_summary_has_a_row_for_the_slider(exact: SimulationResult) -> None:
+    from clearance.analysis.metrics.summary import summarise
+
+    (row,) = summarise(exact)
+    s = exact.sliders[JOINT]
+    touching = (s.corner_penetration > 0).any(axis=1)
+    assert row.joint == JOINT and row.max_penetration == s.corner_penetration.max()
+    assert row.contact_fraction == touching.mean() and row.impacts >= 1
+    assert row.peak_force == np.hypot(s.contact_force[:, 0], s.contact_force[:, 1]).max()
+
+
+@needs_plugin
 def test_exact_energy_terms_carry_the_corners_contact(exact: SimulationResult) -> None:
     e = exact.energy
     assert e["contact_potential"].max() > 0  # the corners stored energy in the impact

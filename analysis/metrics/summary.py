@@ -19,7 +19,8 @@ __all__ = ["JointSummary", "joint_summary", "rms_deviation", "summarise", "summa
 
 @dataclass(frozen=True)
 class JointSummary:
-    """Contact statistics of one clearance joint over a run.
+    """Contact statistics of one clearance joint over a run, or of one slider with play (its deepest
+    corner's penetration, the net contact force on the slider: `summarise`).
 
     Attributes:
         joint: joint name.
@@ -173,7 +174,9 @@ def summary_of_series(
 def summarise(
     result: SimulationResult, ideal: SimulationResult | None = None, *, startup: float = 0.0
 ) -> list[JointSummary]:
-    """One `JointSummary` per clearance joint; the deviation uses the first output.
+    """One `JointSummary` per clearance joint, then one per slider with play (in contact while any
+    corner is: its penetration is the deepest corner's, its force the net contact force on the
+    slider); the deviation uses the first output.
 
     Args:
         result: a run.
@@ -188,7 +191,19 @@ def summarise(
         if (ideal is not None and outputs and startup > 0)
         else nan
     )
-    return [joint_summary(result, j, deviation=dev, startup=startup, steady_deviation=steady) for j in result.joints]
+    rows = [joint_summary(result, j, deviation=dev, startup=startup, steady_deviation=steady) for j in result.joints]
+    return rows + [
+        summary_of_series(
+            j,
+            result.times,
+            sr.corner_penetration.max(axis=1),
+            np.hypot(sr.contact_force[:, 0], sr.contact_force[:, 1]),
+            deviation=dev,
+            startup=startup,
+            steady_deviation=steady,
+        )
+        for j, sr in result.sliders.items()
+    ]
 
 
 def write_summary_csv(rows: list[JointSummary], path: str | Path) -> Path:

@@ -178,8 +178,10 @@ def console_lines(
             )
             continue
         if not r.max_penetration > 0:  # penetration = |e| - c never above 0: the journal never touched
+            what = "the slider's corners" if r.joint in {j.name for j in mech.translational_joints} else "the journal"
+            where = "guide" if what != "the journal" else "bearing"
             lines.append(
-                f"  {r.joint}: no contact (the journal stayed at least {q(-r.max_penetration, 'm')} from the bearing)"
+                f"  {r.joint}: no contact ({what} stayed at least {q(-r.max_penetration, 'm')} from the {where})"
             )
             continue
         if film is not None:
