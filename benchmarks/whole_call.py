@@ -9,12 +9,16 @@ at the default options (`ModelOptions()`, its default step), timed in CPU time
 
   * warm process (imports and the plugin's load done, one call made beforehand):
     - `prepare` on a cache miss (an empty cache folder and the process's shapes forgotten), on a
-      hit from the folder (`clearance.run.cycle_cache`'s files) and on a hit in the process;
+      hit from the folder (`clearance.run.cycle_cache`'s files) and on a hit in the process; the
+      same for the press (`seven_bar_press()`, two drives); the sizing's cycle alone, computed,
+      cached, and the way `prepare` took it before the cache;
     - `simulate_prepared` of the revolutions (the default outputs: every step read out), and with
       its rows thinned to one every 100 µs (what the readout of every step costs);
     - the same model stepped bare: `mujoco.mj_step` in a Python loop from the model's initial
-      keyframe (with and without its sensors), and `mujoco.rollout` (the loop in C, sensors
-      recorded): simulate's overhead per step is against the Python loop with sensors;
+      keyframe, with its outputs' sensors removed group by group (energy meter, acceleration-stage
+      sensors, all but the contact's, all), and `mujoco.rollout` (the loop in C, sensors recorded):
+      simulate's overhead per step is against the Python loop of the run's own model;
+  * at ``--also-us`` steps (with Exudyn): prepare on a miss and the stepping, for the accuracy rows;
   * cold: a fresh interpreter per run with an empty cache folder: the package's import, then
     the first `prepare` (a miss) and the first `simulate_prepared`;
   * Exudyn 1.13.6 when importable (the ``bench`` extra), as `benchmarks/exudyn_peer.py` sets it up
