@@ -173,6 +173,11 @@ def prepare(
     exact = options.contact_mode is ContactMode.EXACT
     _refuse_lubricated(mechanism, options.contact_mode)
     _refuse_slider(mechanism, options.contact_mode)
+    if exact and contact:  # before any work
+        raise ValueError(
+            f"contact parameters were given for {sorted(contact)}, but contact_mode 'exact' computes each joint's "
+            "own contact law and takes no ring parameters; use contact_mode 'nominal' or 'calibrated'"
+        )
     if exact and (cjoints or sliders):
         require_plugin()  # before any work: without the compiled plugin this mode cannot run
         for j in cjoints:
@@ -221,12 +226,6 @@ def prepare(
     params = dict(contact or {})
     slider_params = {k: params.pop(k) for k in sorted(slider_names) if k in params}
     if exact:
-        if params or slider_params:
-            raise ValueError(
-                f"contact parameters were given for {sorted(params | slider_params)}, but contact_mode 'exact' "
-                "computes each joint's own contact law and takes no ring parameters; use contact_mode 'nominal' or "
-                "'calibrated'"
-            )
         contact_meta = {j.name: _add_exact_contact(built, j) for j in cjoints}
     else:
         for j in cjoints:
