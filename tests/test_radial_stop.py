@@ -14,6 +14,7 @@ import re
 import mujoco
 import numpy as np
 import pytest
+from cli_runner import run_cli
 
 from clearance.retrofit import RadialPlay, RetrofitError, RetrofitOptions, retrofit
 from clearance.retrofit.play_tendons import PlayKind, play_tendon_name
@@ -127,3 +128,24 @@ def test_randomised_radial_stops_without_an_inverse_weight_take_a_size_only():
     assert len(set(sizes)) == 3 and all(C <= s <= 2 * C for s in sizes)
     with pytest.raises(RetrofitError, match="no inverse weight at qpos0"):
         randomise_play(m, n_worlds=2, radial=PlayDistribution(stiffness=Uniform(1e4, 1e5)))
+
+
+def test_cli_writes_the_stop_at_the_robot_step_and_refuses_outside(tmp_path, capsys):
+    source = tmp_path / "pendulum.xml"
+    source.write_text(_pendulum("0 1 0"))
+    base = ["retrofit", str(source), "--joint", "pivot:clearance_mm=1", "--no-speed"]
+    code, _, err = run_cli([*base, "--out", str(tmp_path / "out"), "--robot-step", "0.5"], capsys)
+    assert code == 0, err
+    written = mujoco.MjModel.from_xml_path(str(tmp_path / "out" / "model.xml"))
+    tendon = written.tendon(play_tendon_name("pivot", PlayKind.RADIAL)).id
+    assert written.tendon_range[tendon, 1] == C  # 0.001 written and read back: exact in MJCF's text
+    assert written.opt.timestep == 5e-4 and written.nplugin == 0 and written.npair == 0
+    run = tmp_path / "run"
+    code, stdout, err = run_cli(
+        ["run", "--model", str(tmp_path / "out"), "--duration-ms", "300", "--out", str(run)], capsys
+    )
+    assert code == 0, err
+    assert "tendon-limit stops at the robot's step" in stdout and "max penetration" in stdout
+    code, _, err = run_cli([*base, "--out", str(tmp_path / "refused"), "--robot-step", "2"], capsys)
+    assert code == 2 and err.count("\n") == 1 and "give a clearance of at least" in err
+    assert not (tmp_path / "refused").exists()

@@ -160,12 +160,3 @@ def test_cli_refuses_bad_robot_steps_before_any_work(tmp_path, capsys, extra, ex
     )
     assert code == 2 and expected in err and err.count("\n") == 1 and "Traceback" not in err
     assert not out.exists()
-
-
-def test_cli_refuses_a_robot_step_with_radial_play(tmp_path, capsys):
-    source = tmp_path / "flywheel.xml"
-    source.write_text(FLYWHEEL)
-    code, _, err = _cli(
-        ["retrofit", str(source), "--out", str(tmp_path / "o"), "--joint", "shaft", "--robot-step", "1"], capsys
-    )
-    assert code == 2 and "applies to backlash" in err and err.count("\n") == 1

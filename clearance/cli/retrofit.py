@@ -225,7 +225,9 @@ def add_parser(sub: argparse._SubParsersAction[argparse.ArgumentParser]) -> None
         "step represents (MuJoCo's soft limit, its spring time constant two steps, damping fitted to the exact "
         "stop's rebound and impulse), the model and original.xml at that step, no plugin; refused, naming the "
         "largest usable step and the smallest usable band, where the stop would sink more than 20 %% of the band "
-        "under the sizing motion (default: none, the calibrated stop at its own fine step)",
+        "under the sizing motion. Radial play likewise: each journal held within c by a tendon-limit stop (no "
+        "ring, no friction), the model at that step; refused, naming the smallest usable clearance and the "
+        "largest usable step (default: none, the calibrated stop or ring at its own fine step)",
     )
     p.set_defaults(run_command=command)
 
@@ -345,6 +347,7 @@ def _command_line(args: argparse.Namespace) -> str:
         "--sine-frequency-hz",
         "--sizing-control",
         "--sizing-duration-s",
+        "--robot-step",
     ):
         value = getattr(args, flag[2:].replace("-", "_"))
         if value is not None:
@@ -365,10 +368,12 @@ def command(args: argparse.Namespace) -> int:
     backlash = backlash_from_args(args)
     if backlash:
         return backlash_command(args, backlash)
-    if args.robot_step is not None:
+    if args.robot_step is not None and not args.robot_step <= 10.0:
+        raise ValueError(f"--robot-step {args.robot_step:g}: must be at most 10 [ms] (a robot's step is 1-10 ms)")
+    if args.robot_step is not None and args.timestep_us is not None:
         raise ValueError(
-            f"--robot-step {args.robot_step:g}: applies to backlash (--joint NAME:backlash_arcmin=B); radial play at "
-            "the robot's step is not offered by this command"
+            f"--timestep-us {args.timestep_us:g} and --robot-step {args.robot_step:g} both given: with radial play at "
+            "the robot's step the model runs at that step; give one of the two"
         )
     plays = plays_from_args(args)
     options = RetrofitOptions(
@@ -381,6 +386,7 @@ def command(args: argparse.Namespace) -> int:
         sizing_duration=args.sizing_duration_s,
         measure_speed=not args.no_speed,
         accept_inaccurate=args.accept_inaccurate,
+        robot_step=None if args.robot_step is None else si(args.robot_step, "ms"),
     )
     out = check_folder(args.out, "--out")
     path = Path(args.model)

@@ -155,12 +155,22 @@ def run_and_write(
 
 
 def _header(loaded: Retrofitted, duration: float, startup: float, interval: float | None) -> None:
+    from clearance.retrofit.manifest import ROBOT_STEP_MODE
+
     m = loaded.manifest
     play = f"radial play at {[h.name for h in m.hinges]}" if m.hinges else ""
     if m.backlash:
         arcmin = ", ".join(f"{b.name} +-{b.half_width * 10800 / math.pi:.4g}'" for b in m.backlash)
         play = f"{play}; " * bool(play) + f"backlash at {arcmin}"
-    kind = "" if not m.hinges else ", exact contact" if m.contact_mode == "exact" else f", {m.contact_mode} ring"
+    kind = (
+        ""
+        if not m.hinges
+        else ", exact contact"
+        if m.contact_mode == "exact"
+        else ", tendon-limit stops at the robot's step"
+        if m.contact_mode == ROBOT_STEP_MODE
+        else f", {m.contact_mode} ring"
+    )
     print(
         f"{loaded.folder}: {play}, {q(duration, 's', digits=4)} at h = {q(m.timestep, 's')} (the model's own "
         f"{q(m.original_timestep, 's')}){kind}"

@@ -19,9 +19,25 @@ from typing import Any
 
 from clearance.retrofit.play import RetrofitError
 
-__all__ = ["MANIFEST_FILE", "FORMAT", "BacklashRecord", "HingeRecord", "RetrofitManifest", "read_manifest"]
+__all__ = [
+    "MANIFEST_FILE",
+    "FORMAT",
+    "ROBOT_STEP_BOUND",
+    "ROBOT_STEP_MODE",
+    "BacklashRecord",
+    "HingeRecord",
+    "RetrofitManifest",
+    "read_manifest",
+]
 
 MANIFEST_FILE = "retrofit.json"
+
+ROBOT_STEP_MODE = "robot step"
+"""The manifest's contact mode of radial play held by tendon-limit stops at the robot's step."""
+
+ROBOT_STEP_BOUND = 4.0
+"""A robot-step stop's divergence bound over its deepest penetration at the sized closing speed [-]
+(as a ring's is 4 x the Hertz penetration of the sized impact)."""
 FORMAT = 1
 """Version of the file's layout."""
 
@@ -91,7 +107,8 @@ class RetrofitManifest:
         original: the unmodified twin's file name.
         timestep: the retrofitted model's time step [s] (the twin is run at it too).
         original_timestep: the unmodified model's own time step [s].
-        contact_mode: 'calibrated' or 'nominal'.
+        contact_mode: 'calibrated', 'nominal', 'exact', 'robot step' (`ROBOT_STEP_MODE`: radial play held by
+            tendon-limit stops at the robot's step) or 'backlash'.
         hinges: the retrofitted hinges, in the order given.
         qpos_map, qvel_map: index in the retrofitted qpos / qvel of each unmodified entry.
         backlash: the hinges given backlash, in the order given (empty for radial play).

@@ -22,7 +22,14 @@ from clearance.results import atomic_write_text
 from clearance.retrofit.assets import relocate_assets
 from clearance.retrofit.backlash import BacklashRetrofit
 from clearance.retrofit.backlash_report import backlash_report
-from clearance.retrofit.manifest import MANIFEST_FILE, BacklashRecord, HingeRecord, RetrofitManifest
+from clearance.retrofit.manifest import (
+    MANIFEST_FILE,
+    ROBOT_STEP_BOUND,
+    ROBOT_STEP_MODE,
+    BacklashRecord,
+    HingeRecord,
+    RetrofitManifest,
+)
 from clearance.retrofit.pipeline import Retrofit, RetrofittedHinge
 from clearance.retrofit.report import retrofit_report
 
@@ -208,7 +215,7 @@ def manifest_of(result: Retrofit) -> RetrofitManifest:
             force_sensor=h.elements.sensors[1],
             radial_clearance=h.play.clearance.radial_clearance,
             bearing_radius=h.play.clearance.bearing_radius,
-            penetration_limit=h.sizing.penetration_limit,
+            penetration_limit=h.sizing.penetration_limit if h.stop is None else ROBOT_STEP_BOUND * h.stop.penetration,
             segments=h.sizing.segments,
         )
         for h in result.hinges.values()
@@ -218,7 +225,7 @@ def manifest_of(result: Retrofit) -> RetrofitManifest:
         original=TWIN_FILE,
         timestep=result.timestep,
         original_timestep=float(result.twin.opt.timestep),
-        contact_mode=result.options.contact_mode.value,
+        contact_mode=ROBOT_STEP_MODE if result.options.robot_step is not None else result.options.contact_mode.value,
         hinges=hinges,
         qpos_map=tuple(int(i) for i in result.cmap.qpos),
         qvel_map=tuple(int(i) for i in result.cmap.qvel),

@@ -24,6 +24,9 @@ from clearance.run.readout import _exact_contact_force
 
 __all__ = ["RowReader", "default_output_interval", "point_of", "row_bytes", "site_output_names"]
 
+_STOP_FORCE = mujoco.mjtSensor.mjSENS_TENDONLIMITFRC
+"""A hinge whose force sensor is of this type holds its journal by a robot-step radial stop."""
+
 
 def point_of(model: mujoco.MjModel, name: str) -> tuple[str, int]:
     """('site', id) of the site ``name``, else ('body', id) of the body (its origin); KeyError if neither."""
@@ -63,8 +66,12 @@ class RowReader:
             return int(mujoco.mj_name2id(model, kind, name))
 
         self.ecc = {hr.name: sensor(hr.eccentricity_sensor) for hr in hinges}
-        self.exact = {hr.name: sensor_offsets(model, hr.force_sensor) for hr in hinges if hr.segments == 0}
+        stop = {hr.name for hr in hinges if model.sensor(hr.force_sensor).type == _STOP_FORCE}  # robot step
+        self.exact = {
+            hr.name: sensor_offsets(model, hr.force_sensor) for hr in hinges if hr.segments == 0 and hr.name not in stop
+        }
         self.force = {hr.name: sensor(hr.force_sensor) for hr in hinges if hr.segments > 0}
+        self.stop = {hr.name: sensor(hr.force_sensor) for hr in hinges if hr.name in stop}
         self.bearing_site = {hr.name: jid(mujoco.mjtObj.mjOBJ_SITE, hr.bearing_site) for hr in hinges}
         self.slide_dof = {
             hr.name: [int(model.jnt_dofadr[jid(mujoco.mjtObj.mjOBJ_JOINT, s)]) for s in hr.slides] for hr in hinges
@@ -87,6 +94,8 @@ class RowReader:
             e, pen = self.eccentricity(sens, hr)
             if hr.name in self.exact:
                 f = np.hypot(*_exact_contact_force(sens, self.exact[hr.name], e, False)[0].T)  # a dry journal
+            elif hr.name in self.stop:
+                f = np.abs(sens[:, self.stop[hr.name]][:, 0])
             else:
                 f = np.linalg.norm(sens[:, self.force[hr.name]], axis=1)
             out[hr.name] = (pen, f)
@@ -124,6 +133,8 @@ class RowReader:
             rate = v[:, self.slide_dof[hr.name]]
             if hr.name in self.exact:  # the plugin's normal and tangential force, in the bearing frame
                 f = _exact_contact_force(sens, self.exact[hr.name], e, False)[0]  # a retrofit's journals are dry
+            elif hr.name in self.stop:  # the tendon limit pushes the journal back along the line of centres
+                f = _stop_force(sens[:, self.stop[hr.name]][:, 0], e)
             else:
                 # the sensor names only the journal geom, so it reads the force the journal exerts on
                 # the ring: the force on the journal is its opposite
@@ -146,6 +157,14 @@ class RowReader:
             closure_violation=closure,
             body_poses=poses,
         )
+
+
+def _stop_force(force: np.ndarray, e: np.ndarray) -> np.ndarray:
+    """(n, 2) force on the journal in the bearing frame [N] from a radial stop's limit force (n,) [N] (>= 0,
+    `clearance.retrofit.radial_stop`) and the eccentricity (n, 2) [m]: -F e/|e| (0 where |e| = 0)."""
+    size = np.hypot(e[:, 0], e[:, 1])
+    unit = np.divide(e, size[:, None], out=np.zeros_like(e), where=size[:, None] > 0)
+    return -np.abs(force)[:, None] * unit
 
 
 def row_bytes(model: mujoco.MjModel, hinges: int, sites: int, backlash: int) -> int:
