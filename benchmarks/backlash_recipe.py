@@ -22,7 +22,6 @@ Writes ``benchmarks/backlash_recipe.md`` (the text from ``## Reading`` on is kep
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import os
 import sys
@@ -41,6 +40,7 @@ from clearance.retrofit.backlash import BacklashRetrofit, add_backlash, stop_plu
 from clearance.retrofit.motion import control_signal, initial_data
 
 sys.path.insert(0, str(Path(__file__).parent))
+from _gym import gym_model
 from _tables import write_keeping_reading
 
 OUT = Path(__file__).with_suffix(".md")
@@ -53,13 +53,6 @@ FLYWHEEL = """<mujoco model="flywheel"><option timestep="0.001" gravity="0 0 0"/
 FLYWHEEL_B = math.radians(0.5)
 ARM_B_ARCMIN = 5.0
 LIMIT = int(mujoco.mjtConstraint.mjCNSTR_LIMIT_TENDON)
-
-
-def _gym(name: str) -> Path:
-    spec = importlib.util.find_spec("gymnasium")
-    if spec is None or not spec.submodule_search_locations:
-        raise SystemExit("gymnasium is not installed (pip install -e '.[test]')")
-    return Path(next(iter(spec.submodule_search_locations))) / "envs" / "mujoco" / "assets" / f"{name}.xml"
 
 
 def _warnings(data: mujoco.MjData) -> int:
@@ -282,8 +275,8 @@ def _motion_section() -> list[str]:
     cases: list[tuple[str, mujoco.MjSpec, list[str] | None, Callable[[mujoco.MjModel, mujoco.MjData], np.ndarray]]]
     cases = [
         ("flywheel", mujoco.MjSpec.from_string(FLYWHEEL), ["shaft"], _rim),
-        ("reacher", mujoco.MjSpec.from_file(str(_gym("reacher"))), None, _body("fingertip")),
-        ("pusher", mujoco.MjSpec.from_file(str(_gym("pusher"))), None, _body("tips_arm")),
+        ("reacher", mujoco.MjSpec.from_file(str(gym_model("reacher"))), None, _body("fingertip")),
+        ("pusher", mujoco.MjSpec.from_file(str(gym_model("pusher"))), None, _body("tips_arm")),
     ]
     for name, spec, hinges, point in cases:
         plain = spec.copy().compile()

@@ -19,7 +19,6 @@ refuses beyond 1 % of c). Calibrations start from an empty cache (their time is 
 from __future__ import annotations
 
 import argparse
-import importlib.util
 import os
 import platform
 import sys
@@ -30,6 +29,7 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+from _gym import gym_model
 from _tables import write_keeping_reading
 
 from clearance.options import ContactMode
@@ -47,18 +47,11 @@ DURATION = 0.1
 LOOP_C = 1e-4
 
 
-def _gym(name: str) -> str:
-    spec = importlib.util.find_spec("gymnasium")
-    if spec is None or not spec.submodule_search_locations:
-        raise SystemExit("gymnasium is not installed (pip install -e '.[test]')")
-    return str(Path(next(iter(spec.submodule_search_locations))) / "envs" / "mujoco" / "assets" / f"{name}.xml")
-
-
 def _models() -> dict[str, tuple[mujoco.MjSpec, tuple[str, ...], tuple[str, ...], str]]:
     """Name -> (spec, what takes radial play, actuated hinges, end effector)."""
     out = {n: (mujoco.MjSpec.from_string(x), HINGES[n], MOTORS[n], "tip") for n, x in MODELS.items()}
     for name in ("reacher", "pusher"):
-        spec = mujoco.MjSpec.from_file(_gym(name))
+        spec = mujoco.MjSpec.from_file(str(gym_model(name)))
         m = spec.compile()
         hinges = tuple(
             mujoco.mj_id2name(m, mujoco.mjtObj.mjOBJ_JOINT, j)

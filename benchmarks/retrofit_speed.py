@@ -23,15 +23,14 @@ from __future__ import annotations
 
 import argparse
 import datetime
-import importlib.util
 import os
 import platform
-import sys
 import tempfile
 import time
 from pathlib import Path
 
 import mujoco
+from _gym import gym_model
 
 from clearance.model import Material
 from clearance.results import atomic_write_text
@@ -47,13 +46,6 @@ CASES = {
         journal_material=Material(2.4e9, 0.4),
     ),
 }
-
-
-def _model(name: str) -> Path:
-    spec = importlib.util.find_spec("gymnasium")
-    if spec is None or not spec.submodule_search_locations:
-        sys.exit("gymnasium is not installed: pip install -e '.[test]'")
-    return Path(next(iter(spec.submodule_search_locations))) / "envs" / "mujoco" / "assets" / f"{name}.xml"
 
 
 def _hinges(spec: mujoco.MjSpec) -> list[str]:
@@ -73,7 +65,7 @@ def main() -> None:
     load = os.getloadavg()[0]
     rows, speed_rows, notes = [], [], []
     for model_name in ("reacher", "pusher"):
-        path = _model(model_name)
+        path = gym_model(model_name)
         for case, kw in CASES.items():
             with tempfile.TemporaryDirectory() as cache:
                 os.environ["CLEARANCE_CACHE_DIR"] = cache

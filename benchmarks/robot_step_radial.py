@@ -21,7 +21,6 @@ Run: ``python benchmarks/robot_step_radial.py`` (about 2 minutes on 2 cores); wr
 from __future__ import annotations
 
 import copy
-import importlib.util
 import math
 import os
 import sys
@@ -30,6 +29,8 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+from _gym import gym_model
+from _tables import write_keeping_reading
 
 from clearance.options import ContactMode
 from clearance.retrofit import RadialPlay, RetrofitError, RetrofitOptions, SineControl, retrofit
@@ -73,19 +74,11 @@ TIP = "tips_arm"
 OUT = Path(__file__).with_suffix(".md")
 
 
-def model_path(arm: str) -> Path:
-    """gymnasium's ``<arm>.xml`` (found without importing gymnasium)."""
-    spec = importlib.util.find_spec("gymnasium")
-    if spec is None or not spec.submodule_search_locations:
-        raise SystemExit("gymnasium is not installed: pip install gymnasium")
-    return Path(next(iter(spec.submodule_search_locations))) / "envs" / "mujoco" / "assets" / f"{arm}.xml"
-
-
 def feasibility() -> list[str]:
     """Part 1's table rows."""
     rows = []
     for arm, hinges in ARMS.items():
-        spec = mujoco.MjSpec.from_file(str(model_path(arm)))
+        spec = mujoco.MjSpec.from_file(str(gym_model(arm)))
         opts = RetrofitOptions(contact_mode=ContactMode.EXACT, measure_speed=False)
         sized = retrofit(spec, {h: RadialPlay() for h in hinges}, opts)
         integrator = int(sized.twin.opt.integrator)
@@ -145,7 +138,7 @@ def replace_step(model: mujoco.MjModel, step: float) -> mujoco.MjModel:
 
 def validation() -> list[str]:
     """Part 2's table rows."""
-    spec = mujoco.MjSpec.from_file(str(model_path("pusher")))
+    spec = mujoco.MjSpec.from_file(str(gym_model("pusher")))
     rows = []
     for h in ROW_STEPS:
         try:
@@ -234,8 +227,7 @@ def main() -> None:
         *part2,
         "",
     ]
-    OUT.write_text("\n".join(text))
-    print("\n".join(text))
+    print(write_keeping_reading(OUT, "\n".join(text)))
 
 
 if __name__ == "__main__":

@@ -24,6 +24,8 @@ from pathlib import Path
 
 import mujoco
 import numpy as np
+from _gym import gym_model
+from _tables import write_keeping_reading
 
 from clearance.options import ContactMode
 from clearance.retrofit import RadialPlay, RetrofitOptions, SineControl, retrofit, write_retrofit
@@ -47,17 +49,6 @@ TIP = "tips_arm"
 OUT = Path(__file__).with_suffix(".md")
 
 
-def pusher() -> mujoco.MjSpec:
-    """gymnasium's pusher (found without importing gymnasium)."""
-    import importlib.util
-
-    spec = importlib.util.find_spec("gymnasium")
-    if spec is None or not spec.submodule_search_locations:
-        raise SystemExit("gymnasium is not installed: pip install gymnasium")
-    path = Path(next(iter(spec.submodule_search_locations))) / "envs" / "mujoco" / "assets" / "pusher.xml"
-    return mujoco.MjSpec.from_file(str(path))
-
-
 def written(mode: str, folder: Path) -> mujoco.MjModel:
     """The retrofitted pusher (``mode`` 'robot step' or 'exact'), written to ``folder`` and read back."""
     plays = {h: RadialPlay.make(CLEARANCE) for h in HINGES}
@@ -65,7 +56,9 @@ def written(mode: str, folder: Path) -> mujoco.MjModel:
         options = RetrofitOptions(robot_step=STEP, measure_speed=False)
     else:
         options = RetrofitOptions(contact_mode=ContactMode.EXACT, measure_speed=False)
-    paths = write_retrofit(retrofit(pusher(), plays, options), folder / mode.replace(" ", "_"))
+    paths = write_retrofit(
+        retrofit(mujoco.MjSpec.from_file(str(gym_model("pusher"))), plays, options), folder / mode.replace(" ", "_")
+    )
     return mujoco.MjModel.from_xml_path(str(paths["model"]))
 
 
@@ -202,8 +195,7 @@ def main() -> None:
         "(`put_model(..., batch_sizes=...)`); not measured here: this machine has no GPU.",
         "",
     ]
-    OUT.write_text("\n".join(lines))
-    print("\n".join(lines))
+    print(write_keeping_reading(OUT, "\n".join(lines)))
 
 
 if __name__ == "__main__":
