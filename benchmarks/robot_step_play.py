@@ -17,7 +17,7 @@ the same step (5 simulated seconds, best of 3 alternating runs; the issue's goal
 
 Writes ``benchmarks/robot_step_play.md`` (the text from ``## Reading`` on is kept).
 
-    python benchmarks/robot_step_play.py [--duration S]
+    python benchmarks/robot_step_play.py [--duration S] [--arms NAME ...] [--out FILE]
 """
 
 from __future__ import annotations
@@ -221,7 +221,9 @@ def rows_for(name: str, spec: mujoco.MjSpec, step_ms: float, duration: float) ->
 def main() -> None:
     """Run every arm at every step and write the table."""
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    p.add_argument("--duration", type=float, default=2.0, help="seconds of each motion (default 2)")
+    p.add_argument("--duration", type=float, default=6.0, help="seconds of each motion (default 6)")
+    p.add_argument("--arms", nargs="+", default=None, help="only these arms (default: all)")
+    p.add_argument("--out", type=Path, default=OUT, help=f"the table (default {OUT.name} beside this script)")
     args = p.parse_args()
     load = os.getloadavg()
     t0 = time.perf_counter()
@@ -247,11 +249,15 @@ def main() -> None:
     ]
     body = []
     for name, spec in arms():
+        if args.arms is not None and name not in args.arms:
+            continue
         for step_ms in STEPS_MS:
             body += rows_for(name, spec, step_ms, args.duration)
     tail = ["", f"Whole run {time.perf_counter() - t0:.0f} s."]
-    write_keeping_reading(OUT, "\n".join(head + body + tail) + "\n")
-    print(f"wrote {OUT}")
+    command = " ".join([COMMAND, *sys.argv[1:]])
+    head[3] = command
+    write_keeping_reading(args.out, "\n".join(head + body + tail) + "\n")
+    print(f"wrote {args.out}")
 
 
 if __name__ == "__main__":
