@@ -10,6 +10,7 @@ import numpy as np
 from clearance.contact_calibration.fit import GOALS
 from clearance.options import ContactMode
 from clearance.retrofit.insertion import bearing_frame_name
+from clearance.retrofit.manifest import ROBOT_STEP_BOUND
 from clearance.retrofit.masses import PIN_INERTIA, body_label
 from clearance.retrofit.pipeline import Retrofit, RetrofittedHinge
 from clearance.retrofit.play import DEFAULT_CLASS, SineControl
@@ -148,11 +149,14 @@ def _sizing_rows(r: Retrofit) -> list[str]:
     for h in r.hinges.values():
         s = h.sizing
         lo, hi = s.effective_mass_range
+        # a robot-step stop: its own frequency and divergence bound (the bearing's are for the exact contact)
+        omega = s.omega if h.stop is None else h.stop.stop.omega
+        bound = s.penetration_limit if h.stop is None else ROBOT_STEP_BOUND * h.stop.penetration
         rows.append(
             f"| {h.name} | {_g(s.median_load)} | {_g(s.peak_load)} | {_g(s.effective_mass)} ({_g(lo)}–{_g(hi)}) "
-            f"| {_g(s.impact_speed)} | {_g(s.typical_penetration * 1e6)} | {_g(s.penetration_limit * 1e6)} "
-            f"| {s.segments} | {'–' if math.isnan(s.ripple) else f'{s.ripple:.1%}'} | {_g(s.omega)} "
-            f"| {_g(s.omega * r.timestep, 3)} |"
+            f"| {_g(s.impact_speed)} | {_g(s.typical_penetration * 1e6)} | {_g(bound * 1e6)} "
+            f"| {s.segments} | {'–' if math.isnan(s.ripple) else f'{s.ripple:.1%}'} | {_g(omega)} "
+            f"| {_g(omega * r.timestep, 3)} |"
         )
     return rows
 
