@@ -243,9 +243,8 @@ def _summary(parts: list[dict]) -> list[str]:
         )
     lines += [
         "",
-        f"Refusals by listed reason: {_by_reason(reasons)}.",
-        "",
-        f"Ineligible by nature: {_by_reason(natures)}.",
+        f"Over all operations, refusals by listed reason: {_by_reason(reasons)}; ineligible by nature: "
+        f"{_by_reason(natures)} (backlash names a hinge without an actuator no_actuator before its body).",
     ]
     return lines
 
