@@ -6,7 +6,7 @@ benchmarks/robot_step_feasibility.md): its load set spinning into the step-limit
 the motor stands, rebound and impulse per impact against the same flywheel closed by the
 compiled exact stop at its fine step. A band outside the region is refused, and the step and the
 band the refusal names are each accepted when asked for. The written model's band is the
-requested number, bitwise: it is copied, never fitted.
+requested number, bitwise: it is copied, never fitted; ``clearance run --model`` runs it at the step.
 """
 
 from __future__ import annotations
@@ -134,6 +134,10 @@ def test_cli_writes_the_requested_band_exactly_and_refuses_outside(tmp_path, cap
     assert written.opt.timestep == 5e-4 and written.nplugin == 0
     assert mujoco.MjModel.from_xml_path(str(out / "original.xml")).opt.timestep == 5e-4
     assert "At the robot's step (0.5 ms)" in (out / "retrofit.md").read_text() and "step-limited stop" in stdout
+    run = tmp_path / "run"
+    code, stdout, err = _cli(["run", "--model", str(out), "--duration-ms", "600", "--out", str(run)], capsys)
+    assert code == 0, err
+    assert "at h = 500 µs (the model's own 500 µs)" in stdout and "impacts at its ends" in stdout
     refused = tmp_path / "refused"
     code, _, err = _cli(
         ["retrofit", str(source), "--out", str(refused), "--robot-step", "2", "--joint", "shaft:backlash_arcmin=5"],
