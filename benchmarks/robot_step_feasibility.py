@@ -39,8 +39,9 @@ from clearance.retrofit.robot_step import prepare_robot_step, sizing_closings, s
 from clearance.retrofit.step_stop import MAX_PENETRATION, fit_step_stop, smallest_band
 
 sys.path.insert(0, str(Path(__file__).parent))
+from _gym import gym_model
 from _tables import write_keeping_reading
-from backlash_recipe import FLYWHEEL, _gym, _stop_sensors
+from backlash_recipe import FLYWHEEL, _stop_sensors
 
 OUT = Path(__file__).with_suffix(".md")
 FIGURE = Path(__file__).with_suffix(".png")
@@ -56,8 +57,8 @@ def arms() -> list[tuple[str, mujoco.MjSpec, list[str]]]:
     out = []
     for name, spec in (
         ("flywheel", mujoco.MjSpec.from_string(FLYWHEEL)),
-        ("reacher", mujoco.MjSpec.from_file(str(_gym("reacher")))),
-        ("pusher", mujoco.MjSpec.from_file(str(_gym("pusher")))),
+        ("reacher", mujoco.MjSpec.from_file(str(gym_model("reacher")))),
+        ("pusher", mujoco.MjSpec.from_file(str(gym_model("pusher")))),
     ):
         m = spec.copy().compile()
         out.append((name, spec, [m.joint(int(m.actuator_trnid[k, 0])).name for k in range(m.nu)]))

@@ -39,8 +39,9 @@ from clearance.retrofit.motion import control_signal, initial_data
 from clearance.retrofit.robot_step import add_robot_step_backlash, prepare_robot_step, smallest_common_band
 
 sys.path.insert(0, str(Path(__file__).parent))
+from _gym import gym_model
 from _tables import write_keeping_reading
-from backlash_recipe import FLYWHEEL, _band_torques, _gym, _stop_sensors
+from backlash_recipe import FLYWHEEL, _band_torques, _stop_sensors
 from retrofit_corpus import CORPUS, START, model_path
 
 OUT = Path(__file__).with_suffix(".md")
@@ -49,14 +50,17 @@ STEPS_MS = (1.0, 2.0)
 STATS = ("mean", "RMS", "p95")
 COST_SECONDS = 5.0
 """Simulated seconds each cost run steps (under `SineControl()`)."""
+BLOCKS_PER_SECOND = 1
+"""Batch-means blocks per simulated second (one period of the 1 Hz sizing motion)."""
+"""Simulated seconds each cost run steps (under `SineControl()`)."""
 
 
 def arms() -> list[tuple[str, mujoco.MjSpec]]:
     """(name, spec) of each arm; robosuite's from robosuite's start pose (a keyframe), where installed."""
     out = [
         ("flywheel", mujoco.MjSpec.from_string(FLYWHEEL)),
-        ("reacher", mujoco.MjSpec.from_file(str(_gym("reacher")))),
-        ("pusher", mujoco.MjSpec.from_file(str(_gym("pusher")))),
+        ("reacher", mujoco.MjSpec.from_file(str(gym_model("reacher")))),
+        ("pusher", mujoco.MjSpec.from_file(str(gym_model("pusher")))),
     ]
     for name in ("panda", "ur5e"):
         try:
@@ -161,6 +165,13 @@ def stats(x: np.ndarray) -> tuple[float, float, float]:
     return float(np.mean(x)), float(np.sqrt(np.mean(x * x))), float(np.percentile(x, 95))
 
 
+def spread(x: np.ndarray, blocks: int) -> np.ndarray:
+    """Batch-means standard error of (mean, RMS, p95) of ``x``: the statistic per block of whole seconds, the
+    standard deviation over the blocks over sqrt(blocks)."""
+    per = np.array([stats(b) for b in np.array_split(x, blocks)])
+    return per.std(axis=0, ddof=1) / math.sqrt(blocks)
+
+
 def cost(model: mujoco.MjModel, twin: mujoco.MjModel, step: float) -> tuple[float, float]:
     """Wall time per simulated second [s] of ``model`` and of ``twin`` at ``step`` (best of 3 alternating)."""
     best = [math.inf, math.inf]
@@ -188,7 +199,7 @@ def rows_for(name: str, spec: mujoco.MjSpec, step_ms: float, duration: float) ->
         fastest = max(b.closing_speed for b in probe.bands.values())
         return [
             f"| {name} | {step_ms:g} | none up to 600' (fastest closing {fastest:.3g} rad/s at 10') | - | - | - | - | - "
-            "| - | - | - |"
+            "| - | - | - | - |"
         ]
     coarse = add_robot_step_backlash(spec, {j: Backlash.from_arcmin(band) for j in hinges}, robot_step=h)
     exact = add_backlash(spec, {j: Backlash.from_arcmin(band, stop="exact") for j in hinges})
@@ -198,6 +209,8 @@ def rows_for(name: str, spec: mujoco.MjSpec, step_ms: float, duration: float) ->
         e = run(exact.model, exact.twin, control, duration, h)
         sc, se = stats(c.deviation), stats(e.deviation)
         err = [x / y - 1 for x, y in zip(sc, se, strict=True)]
+        blocks = max(2, int(round(duration * BLOCKS_PER_SECOND)))
+        both = 2 * np.hypot(spread(c.deviation, blocks), spread(e.deviation, blocks)) / np.array(se)
         lines.append(
             f"| {name} | {step_ms:g} | {band:g}' | {label} | "
             + " / ".join(f"{1e3 * x:.3g}" for x in sc)
@@ -205,6 +218,8 @@ def rows_for(name: str, spec: mujoco.MjSpec, step_ms: float, duration: float) ->
             + " / ".join(f"{1e3 * x:.3g}" for x in se)
             + " | "
             + " / ".join(f"{100 * x:+.0f} %" for x in err)
+            + " | "
+            + " / ".join(f"{100 * x:.0f} %" for x in both)
             + f" | {c.rebound:.3f} / {e.rebound:.3f} | {c.impacts / duration:.0f} / {e.impacts / duration:.0f} | "
             f"{exact.model.opt.timestep:.2g} | {e.wall:.1f} |"
         )
@@ -212,7 +227,7 @@ def rows_for(name: str, spec: mujoco.MjSpec, step_ms: float, duration: float) ->
     mine, plain = cost(coarse.retrofit.model, coarse.retrofit.twin, h)
     lines.append(
         f"| {name} | {step_ms:g} | {band:g}' | cost | robot step {mine:.3f} s, unmodified {plain:.3f} s per simulated "
-        f"second: {mine / plain:.2f}x | | | | | | |"
+        f"second: {mine / plain:.2f}x | | | | | | | |"
     )
     print(lines[-1], flush=True)
     return lines
@@ -240,12 +255,14 @@ def main() -> None:
         "band represented at the step.",
         "",
         "End-effector deviation from the twin [mm] as mean / RMS / p95 over the samples at the robot's step; "
-        "robot step against exact; error = robot step / exact - 1.",
+        "robot step against exact; error = robot step / exact - 1; spread: twice the combined batch-means standard "
+        "error of the two runs' statistics (blocks of 1 s, one period of the sizing motion), over the exact "
+        "statistic: the sampling scatter a difference of this length has.",
         "",
         "| arm | step [ms] | band | control | robot step: mean / RMS / p95 [mm] | exact: mean / RMS / p95 [mm] | "
-        "error | rebound (robot step / exact) | impacts per s (robot step / exact) | exact step [s] | exact run + twin "
-        "[s] |",
-        "|---|---:|---:|---|---|---|---|---|---|---:|---:|",
+        "error | spread: 2 SE of the difference | rebound (robot step / exact) | impacts per s (robot step / exact) | "
+        "exact step [s] | exact run + twin [s] |",
+        "|---|---:|---:|---|---|---|---|---|---|---|---:|---:|",
     ]
     body = []
     for name, spec in arms():
