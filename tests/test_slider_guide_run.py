@@ -260,3 +260,10 @@ def test_clearance_run_takes_a_slider_with_play(tmp_path: Path, capsys: pytest.C
     assert "## Slider in its guide: slider_guide" in (out / "report.md").read_text()
     res = SimulationResult.load(out / "result")
     assert res.sliders[JOINT].contact_case.max() == SliderContact.ONE_SIDE.value  # the first impact, level
+
+
+def test_clearance_calibrate_says_where_a_slider_is_fitted(capsys: pytest.CaptureFixture[str]) -> None:
+    code, _, err = run_cli(["calibrate", "--clearance-at", "slider_guide"], capsys)
+    errors = [line for line in err.splitlines() if "error:" in line]
+    assert code == 2 and "Traceback" not in err and len(errors) == 1
+    assert "slider's play (slider_guide) is not fitted here: 'clearance run --contact-mode calibrated'" in errors[0]

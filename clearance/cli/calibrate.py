@@ -83,7 +83,16 @@ def main_calibrate(argv: Sequence[str] | None = None) -> int:
         out = check_folder(args.out, "--out")
         mech = mechanism_from_args(args)
         if not mech.clearance_joints:
-            raise ValueError(f"mechanism '{mech.name}' has no clearance joint to calibrate (see --clearance-at)")
+            sliders = [j.name for j in mech.translational_joints]
+            raise ValueError(
+                f"mechanism '{mech.name}' has no clearance joint to calibrate (see --clearance-at)"
+                + (
+                    f"; a slider's play ({', '.join(sliders)}) is not fitted here: 'clearance run --contact-mode "
+                    "calibrated' fits its corners and caches the fit like a ring's"
+                    if sliders
+                    else ""
+                )
+            )
         options = options_from_args(args)
         with folder_lock(out):
             _calibrate(args, mech, options)
