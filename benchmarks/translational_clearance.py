@@ -95,8 +95,10 @@ def siconos_series() -> list[Series]:
 
 
 def our_series(res: SimulationResult, name: str, c: float) -> Series:
-    """A reference run's figure quantities."""
+    """A run's figure quantities (a MuJoCo run has no located contact switches: its samples' only)."""
     sr = res.sliders[JOINT]
+    onsets = res.metadata.get("contact_onsets", {}).get(JOINT)
+    events = [o[0] for o in onsets] + res.metadata["contact_ends"][JOINT] if onsets is not None else []
     q = res.link_poses
     kinetic_gravity = res.energy["kinetic"] + res.energy["gravity_potential"] if res.energy else np.full(len(q), np.nan)
     return Series(
@@ -109,7 +111,7 @@ def our_series(res: SimulationResult, name: str, c: float) -> Series:
         sr.contact_case,
         touched_lines(sr.corner_penetration),
         kinetic_gravity,
-        np.array([o[0] for o in res.metadata["contact_onsets"][JOINT]] + res.metadata["contact_ends"][JOINT]),
+        np.array(events, dtype=float),
     )
 
 

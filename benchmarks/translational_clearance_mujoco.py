@@ -24,10 +24,10 @@ from typing import Any
 import numpy as np
 from _clock import clock, since  # benchmarks/_clock.py (scripts run from benchmarks/)
 from _tables import write_keeping_reading
-from translational_clearance import JOINT, SCENARIO, Series, dead_centre_speeds, episodes, variant
+from translational_clearance import JOINT, SCENARIO, Series, dead_centre_speeds, episodes, our_series, variant
 
 from clearance import ModelOptions, simulate
-from clearance.analysis.metrics.slider import contact_phases, touched_lines
+from clearance.analysis.metrics.slider import contact_phases
 from clearance.builders import load_scenario, slider_crank
 from clearance.options import ContactMode
 from clearance.reference import run_reference
@@ -39,23 +39,6 @@ from clearance.translational import SliderContact
 HERE = Path(__file__).resolve().parent
 DURATION = 0.2  # the examples' final time [s]
 FIRST = 3.5e-3  # the first impact is over by then [s]
-
-
-def series(res: SimulationResult, name: str, c: float) -> Series:
-    """A run's figure quantities (a MuJoCo run's contact switches are its samples')."""
-    sr = res.sliders[JOINT]
-    energy = res.energy["kinetic"] + res.energy["gravity_potential"] if res.energy else np.full(len(res.times), np.nan)
-    return Series(
-        name,
-        res.times,
-        res.link_poses[:, 0, 2],
-        res.drive_speed[:, 0],
-        sr.position[:, 1] / c,
-        sr.tilt,
-        sr.contact_case,
-        touched_lines(sr.corner_penetration),
-        energy,
-    )
 
 
 def first_impact(mech: Any, steps: tuple[float, ...]) -> list[str]:
@@ -103,7 +86,7 @@ def statistics_rows(runs: dict[str, tuple[SimulationResult, float]], base: Serie
     ]
     base_starts = [e[0] for e in episodes(base)]
     for label, (res, wall) in runs.items():
-        sr, s = res.sliders[JOINT], series(res, label, c)
+        sr, s = res.sliders[JOINT], our_series(res, label, c)
         shift = max(abs(e[0] - b) for e, b in zip(episodes(s)[:4], base_starts[:4]))
         on = sr.contact_case != SliderContact.FREE.value
         loaded = sr.corner_force[sr.corner_force > 0]
@@ -217,8 +200,8 @@ def main() -> None:
     orders = convergence_rows(mech)
     cost = step_cost()
     load1 = os.getloadavg()[0]
-    base = series(runs["reference"][0], "reference", c)
-    dry_base = series(dry_runs["reference, mu = 0"][0], "reference, mu = 0", c)
+    base = our_series(runs["reference"][0], "reference", c)
+    dry_base = our_series(dry_runs["reference, mu = 0"][0], "reference, mu = 0", c)
     corner = dry_runs["calibrated, h = 1 us, mu = 0"][0].metadata["contact"][JOINT]
     nominal = dry_runs["nominal, h = 1 us, mu = 0"][0].metadata["contact"][JOINT]
     text = [
@@ -245,7 +228,7 @@ def main() -> None:
         "An episode is every contact phase on one guide line until the slider touches the other one; a phase a "
         "stretch of samples in one contact case (benchmarks/translational_clearance.md).",
         "",
-        *episode_rows([series(r, k, c) for k, (r, _) in runs.items()], 11),
+        *episode_rows([our_series(r, k, c) for k, (r, _) in runs.items()], 11),
         "",
         *statistics_rows(runs, base, c),
         "",
@@ -257,7 +240,7 @@ def main() -> None:
         f"N s/m (at a corner mass of {corner['calibration_mass'] * 1e3:.1f} g). The lone corner's 1.1 g bounds "
         "their step at 1.1 us (the default 2 us is refused with that advice).",
         "",
-        *episode_rows([series(r, k, c) for k, (r, _) in dry_runs.items()], 6),
+        *episode_rows([our_series(r, k, c) for k, (r, _) in dry_runs.items()], 6),
         "",
         *statistics_rows(dry_runs, dry_base, c),
         "",
