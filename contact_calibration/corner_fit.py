@@ -29,7 +29,8 @@ the impact and turns the block (on the published slider-crank of Flores, Leine a
 (2010), whose slider's J is 2.7e-6 kg m², 48 g against 1.1 g). A physical row keeps its k and b,
 so the lone corner is damped far more than the law damps it (2.7 times critical there: its
 impacts barely rebound) and its explicit damping bounds the step: the check is made at the
-lightest corner alone (`check_corner_stability`), and that slider needs h <= 1 µs. Rows
+lightest corner alone, with the margin two corners of one side need when they rock the block
+together (`check_corner_stability`), and that slider needs h <= 0.5-1 µs. Rows
 normalised by the mass they see (nearly hard MuJoCo rows whose reference acceleration sets k/m
 and b/m) kept the law's restitution at every mass but were tried and dropped: their stiffness
 jumps when the slider goes from one corner to level with the rows pressed in, which gave energy
@@ -241,8 +242,17 @@ def nominal_corner_parameters(play: TranslationalClearance, *, mass: float, impa
 def check_corner_stability(
     contact: CornerContact, *, mass: float, timestep: float, max_penetration: float, raise_error: bool = True
 ) -> Stability:
-    """Explicit-step stability of a corner row on ``mass`` [kg]: ω² = k/m, β = b/m, stable for
-    h²ω² + 2hβ < 4 (`clearance.contact_calibration.fit.check_stability`, for one row).
+    """Explicit-step stability of a slider's corner rows on ``mass`` [kg]: ω² = k/m, β = b/m,
+    stable for h²ω² + 2hβ < 2.
+
+    One row alone is stable for h²ω² + 2hβ < 4 (`clearance.contact_calibration.fit.check_stability`).
+    The two corners of one side, both pressed, act together on the slider's tilt, whose inertia
+    over (L/2)² is the lone corner's mass: that mode's ω² and β are twice one row's, so the
+    bound is halved. Measured on the published slider-crank of Flores, Leine and Glocker (2010),
+    without friction: at h²ω² + 2hβ = 3.6 (nominal rows, 1 µs) and 3.8 (calibrated, 2 µs) the
+    slider rocks by 1.3-1.6 mrad within 60 ms where the reference stays level, its corners
+    chattering (40 and 64 onsets against 20); at 2.8 and below it stays level
+    (benchmarks/translational_clearance_mujoco.md).
 
     Args:
         contact: the corner contact.
@@ -260,12 +270,12 @@ def check_corner_stability(
     beta = p.damping / mass
     h = float(timestep)
     st = Stability(float(max_penetration), p.stiffness, p.damping, omega * h, (omega * h) ** 2 + 2 * h * beta)
-    if raise_error and (st.omega_h >= 2.0 or st.damped_bound >= 4.0):
-        h_max = (math.sqrt(beta * beta + 4.0 * omega * omega) - beta) / (omega * omega)  # h²ω² + 2hβ = 4
+    if raise_error and st.damped_bound >= 2.0:  # implies omega h < 1.42
+        h_max = (math.sqrt(beta * beta + 2.0 * omega * omega) - beta) / (omega * omega)  # h²ω² + 2hβ = 2
         raise CalibrationStabilityError(
             f"slider corner contact (stiffness {p.stiffness:.4g} N/m, damping {p.damping:.4g} N s/m) is unstable "
-            f"at time step {h:g} s on a corner of {mass:.3g} kg: omega*h = {st.omega_h:.3f} (must be < 2), "
-            f"h^2 omega^2 + 2 h beta = {st.damped_bound:.3f} (must be < 4); use a time step below {h_max:.3g} s"
+            f"at time step {h:g} s on a corner of {mass:.3g} kg: h^2 omega^2 + 2 h beta = {st.damped_bound:.3f} "
+            f"(must be < 2, two corners rocking the block together); use a time step below {h_max:.3g} s"
         )
     return st
 
