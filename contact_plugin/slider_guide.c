@@ -397,11 +397,53 @@ static void sg_reset(const mjModel* m, mjtNum* plugin_state, void* plugin_data, 
   if (plugin_data) sg_clear((sgData*)plugin_data);
 }
 
+// the cache slot evaluated at d's time, velocities and corner geometry (semi-implicit integrators,
+// where an evaluation costs Jacobians and solves), or -1: the sensor stage reads it instead of
+// evaluating the passive stage's state again (as the journal bearing's same_state_slot)
+static int sg_same_state_slot(const mjModel* m, const mjData* d, const sgData* c) {
+  if (!cl_semi_implicit(m)) {
+    return -1;
+  }
+  int nv = m->nv;
+  const mjtNum* ps = d->site_xpos + 3 * c->slider_site;
+  const mjtNum* rs = d->site_xmat + 9 * c->slider_site;
+  const mjtNum* pg = d->site_xpos + 3 * c->guide_site;
+  const mjtNum* rg = d->site_xmat + 9 * c->guide_site;
+  mjtNum nw[3] = {rg[1], rg[4], rg[7]};
+  mjtNum half = 0.5 * c->height + c->clearance;
+  for (int i = 0; i < CL_NCACHE; i++) {
+    const sgEval* ev = c->cache + i;
+    if (!ev->valid || ev->time != d->time || memcmp(ev->normal, nw, sizeof(nw)) ||
+        memcmp(c->slot_vec + 6 * nv * i, d->qvel, sizeof(mjtNum) * nv)) {
+      continue;
+    }
+    int same = 1;
+    for (int k = 0; k < SG_NC && same; k++) {  // the corners and their gaps, computed as sg_evaluate does
+      mjtNum p[3], rel[3];
+      for (int a = 0; a < 3; a++) {
+        p[a] = ps[a] + kCorner[k][0] * c->length * (a == 0 ? rs[0] : a == 1 ? rs[3] : rs[6]) +
+               kCorner[k][1] * c->height * (a == 0 ? rs[1] : a == 1 ? rs[4] : rs[7]);
+      }
+      mju_sub3(rel, p, pg);
+      same = !memcmp(p, ev->point[k], sizeof(p)) && mju_abs(mju_dot3(nw, rel)) - half == ev->delta[k];
+    }
+    if (same) {
+      return i;
+    }
+  }
+  return -1;
+}
+
 static void sg_compute(const mjModel* m, mjData* d, int instance, int capability_bit) {
   sgData* c = (sgData*)d->plugin_data[instance];
   const mjtNum* s = d->plugin_state + m->plugin_stateadr[instance];
   sgEval ev;
-  sg_evaluate(m, d, c, s, &ev);
+  int same = (capability_bit & mjPLUGIN_PASSIVE) ? -1 : sg_same_state_slot(m, d, c);
+  if (same >= 0) {
+    ev = c->cache[same];  // the sensor stage after the passive stage of one forward pass
+  } else {
+    sg_evaluate(m, d, c, s, &ev);
+  }
   if (capability_bit & mjPLUGIN_PASSIVE) {
     int slot = cl_cache_slot(c->cache, sizeof(sgEval), CL_NCACHE, ev.time, &c->cache_next);
     c->cache[slot] = ev;
