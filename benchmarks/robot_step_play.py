@@ -1,6 +1,9 @@
 """Backlash at the robot's step against the fine-step exact model: end effector, rebound, impacts, cost.
 
-For each arm and robot step (1 and 2 ms), the smallest band represented at every actuated hinge
+Arms: the flywheel of benchmarks/backlash_recipe.py, gymnasium's reacher and pusher, robosuite's Panda and
+UR5e (from robosuite's start pose) as their files stand and as robosuite runs them (`as_robosuite_runs_it`:
+the joint armature, friction loss and damping robosuite's RobotModel adds on loading). For each arm and
+robot step (1 and 2 ms), the smallest band represented at every actuated hinge
 at that step (`robot_step.smallest_common_band`, as benchmarks/robot_step_feasibility.md finds
 it; an arm with none up to 10 degrees gets a row saying so) is given to every actuated hinge
 twice: closed by the step-limited stop at the robot's step (`clearance retrofit --robot-step`),
@@ -70,6 +73,22 @@ def arms() -> list[tuple[str, mujoco.MjSpec]]:
             continue
         spec.add_key(name="start", qpos=list(START[name]))
         out.append((name, spec))
+        out.append((f"{name} as robosuite runs it", as_robosuite_runs_it(spec)))
+    return out
+
+
+def as_robosuite_runs_it(spec: mujoco.MjSpec) -> mujoco.MjSpec:
+    """A copy of a robosuite arm with the joint defaults robosuite's ``RobotModel`` gives it when it loads it
+    (robosuite 1.5.2, robosuite/models/robots/robot_model.py: armature 5/(i+1) kg m^2 on the i-th joint,
+    frictionloss and damping 0.1 where the file sets none; read here as 'where the file's value is 0')."""
+    out = spec.copy()
+    for i, joint in enumerate(out.joints):
+        joint.armature = 5.0 / (i + 1) if joint.armature == 0 else joint.armature
+        joint.frictionloss = 0.1 if joint.frictionloss == 0 else joint.frictionloss
+        damping = np.array(joint.damping, dtype=float)
+        if not damping.any():
+            damping.flat[0] = 0.1  # the linear coefficient
+            joint.damping = damping
     return out
 
 
