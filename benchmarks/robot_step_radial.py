@@ -10,7 +10,8 @@ Part 2, the validation rows: the pusher with radial play at its two shoulder hin
 at the smallest clearance both represent (rounded up to 0.1 mm), against the exact contact
 (the compiled plugin) at its own fine step: the tool tip's deviation from the unmodified
 model's at the same step, |x - x_ideal| over 0.25-2 s (mean, RMS, 95th percentile), under the
-sizing sinusoid (amplitude 0.5, 1 Hz) and under a control the fit never saw (0.7, 1.7 Hz); the
+sizing sinusoid (amplitude 0.5, 1 Hz), under a control the fit never saw (0.7, 1.7 Hz) and under a
+joint-space PD servo tracking sinusoids (a closed loop, `Servo`); the
 stop's impacts (onsets of |e| >= c) against the exact contact's; and the wall time per
 simulated second against the unmodified model's at the same step.
 
@@ -25,6 +26,8 @@ import math
 import os
 import sys
 import time
+from collections.abc import Callable
+from dataclasses import dataclass
 from pathlib import Path
 
 import mujoco
@@ -62,8 +65,31 @@ ROW_HINGES = ["r_shoulder_pan_joint", "r_shoulder_lift_joint"]
 ROW_STEPS = (1e-3, 2e-3)
 """Steps of the validation rows [s]."""
 
-CONTROLS = {"sizing (0.5, 1 Hz)": SineControl(0.5, 1.0), "unseen (0.7, 1.7 Hz)": SineControl(0.7, 1.7)}
-"""The sizing motion and the control the fit never saw."""
+
+@dataclass(frozen=True)
+class Servo:
+    """A joint-space PD servo on every actuated hinge: u = kp (q_ref - q) - kd q', clipped to the control range,
+    q_ref = q(0) + amplitude sin(2 pi f t + 2 pi k / nu) (a closed loop, as a controller or a policy runs).
+
+    Attributes:
+        amplitude [rad], frequency [Hz], kp [N m/rad], kd [N m s/rad].
+    """
+
+    amplitude: float
+    frequency: float
+    kp: float
+    kd: float
+
+
+SIZING = SineControl(0.5, 1.0)
+"""The sizing motion (a retrofit's default)."""
+
+CONTROLS: dict[str, SineControl | Servo] = {
+    "sizing (0.5, 1 Hz)": SIZING,
+    "unseen (0.7, 1.7 Hz)": SineControl(0.7, 1.7),
+    "servo (0.3 rad, 1.3 Hz)": Servo(0.3, 1.3, 10.0, 1.0),
+}
+"""The sizing motion, an open-loop control the fit never saw, and a closed loop."""
 
 DURATION, STARTUP, KEEP = 2.0, 0.25, 1e-3
 """Run length, start-up left out of the statistics, interval of the kept tip positions [s]."""
@@ -98,18 +124,24 @@ def feasibility() -> list[str]:
     return rows
 
 
-def run(model: mujoco.MjModel, control: SineControl, hinges: list[str], c: float) -> tuple[np.ndarray, int, float]:
+def run(
+    model: mujoco.MjModel, control: SineControl | Servo, hinges: list[str], c: float
+) -> tuple[np.ndarray, int, float]:
     """(tip positions every `KEEP` s, impacts: onsets of |e| >= c summed over ``hinges``, deepest |e| - c [m])."""
     data = initial_data(model)
     h = float(model.opt.timestep)
     n, every = int(round(DURATION / h)), max(1, int(round(KEEP / h)))
-    u = control_signal(model, control, np.arange(n) * h)
+    if isinstance(control, Servo):
+        u = servo_controls(model, data, control)
+    else:
+        table = control_signal(model, control, np.arange(n) * h)
+        u = lambda i: table[i]  # noqa: E731
     tip = model.body(TIP).id
     ecc = [model.sensor(f"clr_{j}__ecc").adr[0] for j in hinges]
     touching = np.zeros(len(hinges), dtype=bool)
     out, impacts, deepest = [], 0, -c
     for i in range(n):
-        data.ctrl[:] = u[i]
+        data.ctrl[:] = u(i)
         mujoco.mj_step(model, data)
         if ecc:
             size = np.array([math.hypot(data.sensordata[k], data.sensordata[k + 1]) for k in ecc])
@@ -122,8 +154,25 @@ def run(model: mujoco.MjModel, control: SineControl, hinges: list[str], c: float
     return np.array(out), impacts, deepest
 
 
+def servo_controls(model: mujoco.MjModel, data: mujoco.MjData, servo: Servo) -> Callable[[int], np.ndarray]:
+    """Step index -> the servo's controls from ``data``'s present state (each actuator's hinge by its joint)."""
+    joints = [int(model.actuator_trnid[a, 0]) for a in range(model.nu)]
+    qa = np.array([model.jnt_qposadr[j] for j in joints])
+    va = np.array([model.jnt_dofadr[j] for j in joints])
+    start = data.qpos[qa].copy()
+    phase = 2 * math.pi * np.arange(model.nu) / max(model.nu, 1)
+    lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
+    h = float(model.opt.timestep)
+
+    def controls(i: int) -> np.ndarray:
+        ref = start + servo.amplitude * np.sin(2 * math.pi * servo.frequency * i * h + phase)
+        return np.clip(servo.kp * (ref - data.qpos[qa]) - servo.kd * data.qvel[va], lo, hi)
+
+    return controls
+
+
 def deviation(
-    model: mujoco.MjModel, twin: mujoco.MjModel, control: SineControl, c: float
+    model: mujoco.MjModel, twin: mujoco.MjModel, control: SineControl | Servo, c: float
 ) -> tuple[np.ndarray, int, float]:
     """(mean, RMS, p95 of the tip's |x - x_ideal| after start-up [m], impacts, deepest |e| - c [m]) of ``model``
     against ``twin``."""
@@ -159,7 +208,7 @@ def validation() -> list[str]:
         exact = retrofit(spec, plays, exact_options)
         sunk = c + max(s.stop.penetration for s in coarse.hinges.values())
         deeper = retrofit(spec, {j: RadialPlay.make(sunk) for j in ROW_HINGES}, exact_options)
-        cost = [measure_speed(m, CONTROLS["sizing (0.5, 1 Hz)"]) for m in (coarse.model, replace_step(coarse.twin, h))]
+        cost = [measure_speed(m, SIZING) for m in (coarse.model, replace_step(coarse.twin, h))]
         ratio = cost[1].steps_per_second / cost[0].steps_per_second
         for label, control in CONTROLS.items():
             t0 = time.perf_counter()
