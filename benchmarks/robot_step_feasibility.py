@@ -8,8 +8,8 @@ at most 0.2 b at the fastest closing under the sizing motion (`SineControl()`, 1
 retrofitted model runs at h (`clearance.retrofit.robot_step`):
 
 - analytic: b >= p h v / 0.2 for a given closing speed (the dashed lines of the figure);
-- per arm (the flywheel of benchmarks/backlash_recipe.py, gymnasium's reacher and pusher, every
-  actuated hinge given the same band): for steps 0.5, 1, 2, 5 and 10 ms, bands 1'-60', the
+- per arm (the flywheel of benchmarks/backlash_recipe.py, gymnasium's reacher and pusher, and robosuite's
+  Panda and UR5e with the armature robosuite gives their joints; every actuated hinge given the same band): for steps 0.5, 1, 2, 5 and 10 ms, bands 1'-60', the
   fastest closing and the deepest penetration measured in the sizing run, against p h v; and
   the smallest band on the ladder 1'..600' (10 degrees) represented at every hinge
   (`robot_step.smallest_common_band`), the arm's curve in the figure;
@@ -42,6 +42,8 @@ sys.path.insert(0, str(Path(__file__).parent))
 from _gym import gym_model
 from _tables import write_keeping_reading
 from backlash_recipe import FLYWHEEL, _stop_sensors
+from robot_step_play import actuated
+from robot_step_play import arms as robosuite_arms
 
 OUT = Path(__file__).with_suffix(".md")
 FIGURE = Path(__file__).with_suffix(".png")
@@ -53,7 +55,8 @@ SPEED_LINES = (0.3, 1.0, 3.0)
 
 
 def arms() -> list[tuple[str, mujoco.MjSpec, list[str]]]:
-    """(name, spec, actuated hinges) of the three arms."""
+    """(name, spec, actuated hinges) of the flywheel, the reacher, the pusher, and robosuite's Panda and UR5e as
+    robosuite runs them (`robot_step_play.as_robosuite_runs_it`), where robosuite is installed."""
     out = []
     for name, spec in (
         ("flywheel", mujoco.MjSpec.from_string(FLYWHEEL)),
@@ -62,6 +65,9 @@ def arms() -> list[tuple[str, mujoco.MjSpec, list[str]]]:
     ):
         m = spec.copy().compile()
         out.append((name, spec, [m.joint(int(m.actuator_trnid[k, 0])).name for k in range(m.nu)]))
+    for name, spec in robosuite_arms():
+        if name.endswith("as robosuite runs it"):
+            out.append((name.replace(" as robosuite runs it", " (robosuite's armature)"), spec, actuated(spec)))
     return out
 
 
@@ -190,7 +196,7 @@ def figure(curves: dict[str, dict[float, float | None]], pvals: dict[int, float]
         ax.text(
             11, _arcmin(1) * p * 11e-3 * v / MAX_PENETRATION, f"v = {v:g} rad/s", fontsize=7, ha="right", va="bottom"
         )
-    for (name, curve), marker in zip(curves.items(), ("o", "s", "^")):
+    for (name, curve), marker in zip(curves.items(), ("o", "s", "^", "D", "v")):
         xs = [s for s, b in curve.items() if b is not None]
         ax.loglog(xs, [curve[s] for s in xs], marker + "-", label=name)
         none = [s for s, b in curve.items() if b is None]
