@@ -35,7 +35,7 @@ import numpy as np
 from clearance.contact_calibration.torsional_stop import MeshLaw
 from clearance.retrofit import Backlash, SineControl
 from clearance.retrofit.backlash import add_backlash
-from clearance.retrofit.robot_step import prepare_robot_step, sizing_closings, smallest_common_band
+from clearance.retrofit.robot_step import add_robot_step_backlash, sizing_closings, smallest_common_band
 from clearance.retrofit.step_stop import MAX_PENETRATION, fit_step_stop, smallest_band
 
 sys.path.insert(0, str(Path(__file__).parent))
@@ -123,8 +123,11 @@ def measure() -> tuple[list[str], dict[str, dict[float, float | None]], dict[int
         curves[name] = {}
         for step_ms in STEPS_MS:
             t0 = time.perf_counter()
-            r = prepare_robot_step(
-                spec, {h: Backlash.from_arcmin(BANDS_ARCMIN[0]) for h in hinges}, robot_step=step_ms * 1e-3
+            r = add_robot_step_backlash(
+                spec,
+                {h: Backlash.from_arcmin(BANDS_ARCMIN[0]) for h in hinges},
+                robot_step=step_ms * 1e-3,
+                refuse=False,
             )
             pvals[int(r.retrofit.model.opt.integrator)] = r.stop.penetration / r.stop.timestep
             run, cells = r.sizing, []
@@ -170,8 +173,8 @@ def check_section() -> list[str]:
         fast, step, wall = exact_closings(spec, hinges, CHECK_ARCMIN)
         coarse = []
         for step_ms in (0.5, 1.0):
-            r = prepare_robot_step(
-                spec, {h: Backlash.from_arcmin(CHECK_ARCMIN) for h in hinges}, robot_step=step_ms * 1e-3
+            r = add_robot_step_backlash(
+                spec, {h: Backlash.from_arcmin(CHECK_ARCMIN) for h in hinges}, robot_step=step_ms * 1e-3, refuse=False
             )
             coarse.append(", ".join(f"{b.closing_speed:.3g}" for b in r.bands.values()))
         lines.append(

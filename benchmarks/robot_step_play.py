@@ -39,7 +39,7 @@ import numpy as np
 from clearance.retrofit import Backlash, ControlTable, SineControl
 from clearance.retrofit.backlash import add_backlash
 from clearance.retrofit.motion import control_signal, initial_data
-from clearance.retrofit.robot_step import add_robot_step_backlash, prepare_robot_step, smallest_common_band
+from clearance.retrofit.robot_step import add_robot_step_backlash, smallest_common_band
 
 sys.path.insert(0, str(Path(__file__).parent))
 from _gym import gym_model
@@ -212,7 +212,7 @@ def rows_for(name: str, spec: mujoco.MjSpec, step_ms: float, duration: float) ->
     """The table's rows of one arm at one step."""
     hinges = actuated(spec)
     h = step_ms * 1e-3
-    probe = prepare_robot_step(spec, {j: Backlash.from_arcmin(10) for j in hinges}, robot_step=h)
+    probe = add_robot_step_backlash(spec, {j: Backlash.from_arcmin(10) for j in hinges}, robot_step=h, refuse=False)
     band = smallest_common_band(probe.sizing, probe.stop)
     if band is None:
         fastest = max(b.closing_speed for b in probe.bands.values())

@@ -43,6 +43,7 @@ from clearance.retrofit.step_stop import (
 __all__ = [
     "ROBOT_STEP_STOP",
     "SETTLE",
+    "STEP_FLOOR",
     "BandAtStep",
     "RobotStepBacklash",
     "SizingRun",
@@ -50,7 +51,6 @@ __all__ = [
     "LADDER",
     "ladder",
     "largest_common_step",
-    "prepare_robot_step",
     "set_robot_step",
     "sizing_closings",
     "smallest_common_band",
@@ -61,6 +61,9 @@ ROBOT_STEP_STOP = "robot-step"
 
 SETTLE = 0.02
 """A step counts as below the asked one when it is at least this fraction [-] smaller."""
+
+STEP_FLOOR = 0.05
+"""The smallest step a refusal tries, as a fraction [-] of the asked step."""
 
 LADDER = (1.0, 1.2, 1.5, 2.0, 2.5, 3.0, 4.0, 5.0, 6.0, 8.0)
 """Mantissas of the bands [arcmin] and steps [ms] a refusal tries: values a user can type back."""
@@ -213,7 +216,7 @@ def smallest_common_band(run: SizingRun, stop: StepStop, *, lo_arcmin: float = 1
         run.model.tendon_range[:] = saved
 
 
-def largest_common_step(run: SizingRun, stop: StepStop, *, down_to: float = 0.05) -> float | None:
+def largest_common_step(run: SizingRun, stop: StepStop, *, down_to: float = STEP_FLOOR) -> float | None:
     """Largest step [ms] on `ladder` below ``stop``'s, down to ``down_to`` of it, at which it represents
     every band of ``run.model``, or None.
 
@@ -241,6 +244,7 @@ def add_robot_step_backlash(
     robot_step: float,
     control: SineControl | ControlTable | None = None,
     duration: float = 1.0,
+    refuse: bool = True,
 ) -> RobotStepBacklash:
     """Give actuated hinges backlash at the robot's step ``robot_step``, or refuse where it is not represented.
 
@@ -251,6 +255,8 @@ def add_robot_step_backlash(
         robot_step: the step the model will run at, h [s].
         control: the sizing motion (default `SineControl()`).
         duration: the sizing motion's length [s].
+        refuse: raise where a band is not represented (default); False returns the model and
+            its measures anyway (a study of the region: `smallest_common_band`, `largest_common_step`).
 
     Returns:
         The model at h (twin at h too) with each band's step-limited stop, and each band's
@@ -258,16 +264,15 @@ def add_robot_step_backlash(
 
     Raises:
         RetrofitError: a band the stop does not represent at h (naming the largest step for the
-            bands and the smallest band for the step), a backlash asking for another stop, and
-            every refusal of `add_backlash`.
+            bands and the smallest band for the step), a backlash asking for another stop, bands
+            with different mesh laws, and every refusal of `add_backlash`.
         ValueError: a step or duration that is not a positive number.
     """
     h = positive("robot_step", robot_step, "s")
-    t_run = positive("duration", duration, "s")
-    result = prepare_robot_step(spec, joints, robot_step=h, control=control, duration=t_run)
+    result = _build(spec, joints, h, control, positive("duration", duration, "s"))
     stop = result.stop
     bands = list(result.bands.values())
-    if all(b.smallest_band <= b.half_width for b in bands):
+    if not refuse or all(b.smallest_band <= b.half_width for b in bands):
         return result
     worst = max(bands, key=lambda b: b.smallest_band / b.half_width)
     step = largest_common_step(result.sizing, stop)
@@ -277,7 +282,7 @@ def add_robot_step_backlash(
         f"(the step-limited stop would sink {worst.smallest_band / worst.half_width * MAX_PENETRATION:.2g} b at its "
         f"fastest closing {worst.closing_speed:.3g} rad/s under the sizing motion; at most {MAX_PENETRATION:g} b): "
         + (
-            "no step down to 0.01 ms represents these bands"
+            f"no step down to {STEP_FLOOR * h * 1e3:g} ms represents these bands"
             if step is None
             else f"the largest usable step for these bands is {step:g} ms"
         )
@@ -291,23 +296,14 @@ def add_robot_step_backlash(
     )
 
 
-def prepare_robot_step(
+def _build(
     spec: mujoco.MjSpec,
     joints: Mapping[str, Backlash],
-    *,
-    robot_step: float,
-    control: SineControl | ControlTable | None = None,
-    duration: float = 1.0,
+    h: float,
+    control: SineControl | ControlTable | None,
+    t_run: float,
 ) -> RobotStepBacklash:
-    """`add_robot_step_backlash` without the refusal: the model, its stops and each band's measures.
-
-    Raises:
-        RetrofitError: a backlash asking for another stop, bands with different mesh laws, and
-            every refusal of `add_backlash`.
-        ValueError: a step or duration that is not a positive number.
-    """
-    h = positive("robot_step", robot_step, "s")
-    t_run = positive("duration", duration, "s")
+    """The model at step ``h`` [s] with its step-limited stops, and each band's measures under the sizing motion."""
     of_type("joints", joints, Mapping, "a mapping hinge name -> Backlash")
     for name, play in joints.items():
         of_type(f"joints[{name!r}]", play, Backlash, f"a Backlash (the backlash of hinge '{name}')")
