@@ -29,6 +29,10 @@ G = 9.81
 """Gravity [m/s^2] (MuJoCo's default)."""
 
 
+_MOTOR = '<actuator><motor name="m" joint="pivot" ctrlrange="-20 20"/></actuator>'
+"""A motor on the pendulum's pivot (20 N m at full control)."""
+
+
 def _pendulum(axis: str) -> str:
     return f"""<mujoco><option timestep="0.002"/><worldbody>
 <body name="link" pos="0 0 1"><joint name="pivot" axis="{axis}" damping="0.05"/>
@@ -149,3 +153,17 @@ def test_cli_writes_the_stop_at_the_robot_step_and_refuses_outside(tmp_path, cap
     code, _, err = run_cli([*base, "--out", str(tmp_path / "refused"), "--robot-step", "2"], capsys)
     assert code == 2 and err.count("\n") == 1 and "give a clearance of at least" in err
     assert not (tmp_path / "refused").exists()
+
+
+def test_a_run_driven_harder_than_the_sizing_motion_is_told_it_left_the_region(tmp_path, capsys):
+    source = tmp_path / "pendulum.xml"
+    source.write_text(_pendulum("0 1 0").replace("</mujoco>", _MOTOR + "</mujoco>"))
+    out = tmp_path / "out"
+    argv = ["retrofit", str(source), "--joint", "pivot:clearance_mm=1", "--robot-step", "0.5", "--no-speed"]
+    code, _, err = run_cli([*argv, "--sine-amplitude", "0.005", "--out", str(out)], capsys)  # sized gently
+    assert code == 0, err
+    run = ["run", "--model", str(out), "--duration-ms", "1500", "--sine-amplitude", "1", "--sine-frequency-hz", "2"]
+    code, stdout, err = run_cli([*run, "--out", str(tmp_path / "run")], capsys)
+    # measured: the stop sinks 49 % of c (allowed 20 %) and passes its divergence bound (625 against 552 um)
+    assert re.search(r"warning: pivot's stop sank \d+% of c \(its region allows 20%\)", stdout), stdout
+    assert code == 2 and "a larger clearance or a smaller --robot-step" in err

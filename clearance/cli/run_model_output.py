@@ -145,6 +145,8 @@ def run_and_write(
                 result, twin, loaded.model, loaded.twin, recording, deviation=deviations[0] if deviations else None
             )
     _console(args, rows, backlash, deviations, sensitivity, startup)
+    for line in _outside_region(loaded, rows):
+        print(line)
     rate = float(f"{result.metadata['steps_per_second']:.3g}")
     rrd = None if not args.rerun else Path(args.rerun).resolve()
     print(f"  {rate:,.0f} steps/s; wrote {out}/" + ("" if rrd is None else f" and {rrd}"))
@@ -152,6 +154,25 @@ def run_and_write(
         print(f"error: {failed}", file=sys.stderr)
         return 2
     return 0
+
+
+def _outside_region(loaded: Retrofitted, rows: list[JointSummary]) -> list[str]:
+    """A warning per robot-step radial stop that sank beyond the share of c its region allows
+    (`clearance.retrofit.step_stop.MAX_PENETRATION`): the run's control closed it faster than the sizing motion."""
+    from clearance.retrofit.manifest import ROBOT_STEP_MODE
+    from clearance.retrofit.step_stop import MAX_PENETRATION
+
+    m = loaded.manifest
+    if m.contact_mode != ROBOT_STEP_MODE:
+        return []
+    c = {h.name: h.radial_clearance for h in m.hinges}
+    return [
+        f"  warning: {r.joint}'s stop sank {r.max_penetration / c[r.joint]:.0%} of c (its region allows "
+        f"{MAX_PENETRATION:.0%}): this run closes it faster than the sizing motion did, so the robot-step stop is "
+        "outside where it was fitted; retrofit with a larger clearance or a smaller --robot-step"
+        for r in rows
+        if r.joint in c and r.max_penetration > MAX_PENETRATION * c[r.joint]
+    ]
 
 
 def _header(loaded: Retrofitted, duration: float, startup: float, interval: float | None) -> None:

@@ -36,7 +36,7 @@ import numpy as np
 
 from clearance.results import SimulationResult
 from clearance.retrofit.drive import Drive, drive_controls
-from clearance.retrofit.manifest import HingeRecord, RetrofitManifest, read_manifest
+from clearance.retrofit.manifest import ROBOT_STEP_MODE, HingeRecord, RetrofitManifest, read_manifest
 from clearance.retrofit.motion import initial_data, scalar_coordinates
 from clearance.retrofit.play import RetrofitError
 from clearance.run.backlash_readout import add_backlash_sensors
@@ -235,6 +235,11 @@ def _remedy(loaded: Retrofitted, twin: bool) -> str:
         return f"the unmodified model does not run at the retrofit's step {h:g} s under these controls; check them"
     if not loaded.manifest.hinges:
         return "drive the model more gently (a smaller --sine-amplitude), or give the hinges a wider backlash band"
+    if loaded.manifest.contact_mode == ROBOT_STEP_MODE:
+        return (
+            f"retrofit again with a larger clearance or a smaller --robot-step (now {h * 1e3:g} ms), sized from a "
+            "motion as strong as this one (--sizing-control), or drive the model more gently"
+        )
     return (
         f"retrofit again with a smaller time step (--timestep-us {h * 1e6 / 2:g}; now {h * 1e6:g}) or more ring "
         "segments (--segments), or drive the model more gently"
@@ -259,7 +264,7 @@ def _first_bad(
             worst[0],
             worst[1],
             f"the journal penetrated {worst[2] * 1e6:.3g} um into its bearing, beyond the bound {worst[3] * 1e6:.3g} "
-            "um (4 x the Hertz penetration of the sized impact)",
+            "um (4 x the penetration of the sized impact)",
         )
     if first_nan < n:
         return first_nan, None, "the state became non-finite (NaN or Inf)"
