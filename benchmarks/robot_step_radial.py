@@ -36,7 +36,7 @@ from _gym import gym_model
 from _tables import write_keeping_reading
 
 from clearance.options import ContactMode
-from clearance.retrofit import RadialPlay, RetrofitError, RetrofitOptions, SineControl, retrofit
+from clearance.retrofit import RadialPlay, Retrofit, RetrofitError, RetrofitOptions, SineControl, retrofit
 from clearance.retrofit.motion import control_signal, initial_data
 from clearance.retrofit.radial_stop import exact_bearing_impact, smallest_clearance
 from clearance.retrofit.speed import measure_speed
@@ -90,6 +90,11 @@ CONTROLS: dict[str, SineControl | Servo] = {
     "servo (0.3 rad, 1.3 Hz)": Servo(0.3, 1.3, 10.0, 1.0),
 }
 """The sizing motion, an open-loop control the fit never saw, and a closed loop."""
+
+ENSEMBLE = tuple(
+    SineControl(a, f) for a, f in ((0.55, 0.8), (0.6, 1.2), (0.65, 2.1), (0.75, 1.4), (0.8, 0.9), (0.7, 2.4))
+)
+"""More open-loop controls the fit never saw (amplitude, frequency [Hz]): the means over them, and their spread."""
 
 DURATION, STARTUP, KEEP = 2.0, 0.25, 1e-3
 """Run length, start-up left out of the statistics, interval of the kept tip positions [s]."""
@@ -232,7 +237,25 @@ def validation() -> list[str]:
                 + " / ".join(f"{e:+.1%}" for e in moved)
                 + f" | {n_exact} / {n_coarse} | {sank / c:.0%} | {ratio:.2f} |"
             )
+        rows.append(ensemble_row(h, c, coarse, exact))
     return rows
+
+
+def ensemble_row(h: float, c: float, coarse: Retrofit, exact: Retrofit) -> str:
+    """The statistics' means over the `ENSEMBLE` controls, robot step against exact, with twice the standard error
+    of their paired difference over the controls."""
+    runs = np.array([[deviation(m.model, m.twin, control, c)[0] for m in (coarse, exact)] for control in ENSEMBLE])
+    got, want = runs[:, 0].mean(axis=0), runs[:, 1].mean(axis=0)
+    se2 = 2 * (runs[:, 0] - runs[:, 1]).std(axis=0, ddof=1) / math.sqrt(len(ENSEMBLE)) / want
+    return (
+        f"| {h * 1e3:g} | {c * 1e3:.1f} | {len(ENSEMBLE)} more unseen sinusoids (mean) | "
+        + " / ".join(f"{x * 1e3:.3f}" for x in want)
+        + " | "
+        + " / ".join(f"{x * 1e3:.3f}" for x in got)
+        + " | "
+        + " / ".join(f"{e:+.1%} ± {u:.0%}" for e, u in zip(got / want - 1.0, se2, strict=True))
+        + " | – | – | – | – | – |"
+    )
 
 
 def main() -> None:
@@ -273,7 +296,9 @@ def main() -> None:
         "reference itself is from converged: a smaller step changes its impact sequence). Exact at c + δ: the "
         "exact contact with the clearance widened by the robot-step stop's deepest penetration δ at the closing "
         "speed (the clearance the stop lets the journal reach), against the exact contact at c: how much of the "
-        "robot step's error the stop's softness alone explains. Deepest / c: the robot-step run's deepest |e| - c "
+        "robot step's error the stop's softness alone explains. The last row per step: the means of the statistics over "
+        f"{len(ENSEMBLE)} more sinusoids the fit never saw, error ± twice the standard error of the paired difference "
+        "over them. Deepest / c: the robot-step run's deepest |e| - c "
         "over c (the region allows 20 % at the sizing motion's closing speed; a stronger control closes faster).",
         "",
         "| step [ms] | c [mm] | control | exact contact (its step, wall) | robot step | error | exact's spread "
