@@ -15,6 +15,7 @@ import mujoco
 import numpy as np
 import pytest
 from cli_runner import run_cli
+from retrofit_models import HINGES, MODELS
 
 from clearance.retrofit import RadialPlay, RetrofitError, RetrofitOptions, retrofit
 from clearance.retrofit.play_tendons import PlayKind, play_tendon_name
@@ -167,3 +168,20 @@ def test_a_run_driven_harder_than_the_sizing_motion_is_told_it_left_the_region(t
     # measured: the stop sinks 49 % of c (allowed 20 %) and passes its divergence bound (625 against 552 um)
     assert re.search(r"warning: pivot's stop sank \d+% of c \(its region allows 20%\)", stdout), stdout
     assert code == 2 and "a larger clearance or a smaller --robot-step" in err
+
+
+@pytest.mark.parametrize("name", sorted(MODELS))
+def test_every_convention_model_takes_the_robot_step_stop(name):
+    # the hand-written models load their hinges far faster than a robot's (they are refused at 1 ms, c = 1 mm);
+    # at 50 us each stop is inside its region, and the retrofit's own checks (masses, conventions) pass
+    plays = {h: RadialPlay.make(C) for h in HINGES[name]}
+    r = retrofit(mujoco.MjSpec.from_string(MODELS[name]), plays, RetrofitOptions(robot_step=5e-5, measure_speed=False))
+    m = r.model
+    for h in HINGES[name]:
+        assert m.tendon_range[m.tendon(play_tendon_name(h, PlayKind.RADIAL)).id, 1] == C
+        assert r.hinges[h].stop.penetration <= MAX_PENETRATION * C
+    d = mujoco.MjData(m)
+    for _ in range(1000):  # 50 ms
+        mujoco.mj_step(m, d)
+    fired = [mujoco.mjtWarning(i).name for i, w in enumerate(d.warning) if w.number]
+    assert not fired, fired
