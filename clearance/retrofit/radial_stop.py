@@ -28,8 +28,10 @@ torque it puts on the hinge, are absent: with the default friction 0 nothing is 
 Hertz stiffening: the stop's force is linear in the penetration, its duration fixed by ω̂
 (about π/ω̂ = 2π h, 100-1000 times the exact impact's), and its penetration p h v (p about 1.9)
 where the exact bearing's is µm: a journal pressed by a steady load sits (1 - d) a/ω̂² past c
-(d = 0.99, a the load over the effective mass). So the stop keeps each impact's momentum
-exchange (rebound, impulse) and the clearance's geometry, not its force history.
+(d = 0.99, a the load over the effective mass) and chatters there by a few a h² (a one-sided limit:
+each step off it the load moves the journal a h²; measured at most 2 % of c on a hanging pendulum).
+So the stop keeps each impact's momentum exchange (rebound, impulse) and the clearance's geometry,
+not its force history.
 
 Where it represents the play. The journal meets the stop at about the speed it gains
 crossing the clearance under the hinge's peak load, v = sqrt(2 a c) (a = peak load over the
