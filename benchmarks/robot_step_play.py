@@ -20,7 +20,7 @@ the same step (5 simulated seconds, best of 3 alternating runs; the issue's goal
 
 Writes ``benchmarks/robot_step_play.md`` (the text from ``## Reading`` on is kept).
 
-    python benchmarks/robot_step_play.py [--duration S] [--arms NAME ...] [--out FILE]
+    python benchmarks/robot_step_play.py [--duration S] [--trajectories K] [--arms NAME ...] [--out FILE]
 """
 
 from __future__ import annotations
@@ -37,7 +37,7 @@ import mujoco
 import numpy as np
 
 from clearance.retrofit import Backlash, ControlTable, SineControl
-from clearance.retrofit.backlash import add_backlash
+from clearance.retrofit.backlash import BacklashRetrofit, add_backlash
 from clearance.retrofit.motion import control_signal, initial_data
 from clearance.retrofit.robot_step import add_robot_step_backlash, smallest_common_band
 
@@ -98,15 +98,16 @@ def actuated(spec: mujoco.MjSpec) -> list[str]:
     return [m.joint(int(m.actuator_trnid[k, 0])).name for k in range(m.nu)]
 
 
-def unseen_control(model: mujoco.MjModel, duration: float) -> ControlTable:
+def unseen_control(model: mujoco.MjModel, duration: float, seed: int = 0) -> ControlTable:
     """Two sinusoids per actuator (0.43 and 1.7 Hz; 35 % and 25 % of the control half-range; phases 1.3 k and
-    0.7 k^2), sampled every 10 ms: a motion the fit and the region never saw."""
+    0.7 k^2, plus 2.4 s and 1.1 s for another ``seed``), sampled every 10 ms: a motion the fit and the region
+    never saw."""
     t = np.arange(0.0, duration + 0.01, 0.01)
     k = np.arange(model.nu)[None, :]
     lo, hi = model.actuator_ctrlrange[:, 0], model.actuator_ctrlrange[:, 1]
     mid, half = 0.5 * (lo + hi), 0.5 * (hi - lo)
-    wave = 0.35 * np.sin(2 * np.pi * 0.43 * t[:, None] + 1.3 * k) + 0.25 * np.sin(
-        2 * np.pi * 1.7 * t[:, None] + 0.7 * k**2
+    wave = 0.35 * np.sin(2 * np.pi * 0.43 * t[:, None] + 1.3 * k + 2.4 * seed) + 0.25 * np.sin(
+        2 * np.pi * 1.7 * t[:, None] + 0.7 * k**2 + 1.1 * seed
     )
     return ControlTable(t, mid[None, :] + half[None, :] * wave, "unseen two-sine control")
 
@@ -191,6 +192,43 @@ def spread(x: np.ndarray, blocks: int) -> np.ndarray:
     return per.std(axis=0, ddof=1) / math.sqrt(blocks)
 
 
+def ensemble_row(
+    name: str,
+    step_ms: float,
+    band: float,
+    coarse: BacklashRetrofit,
+    exact: BacklashRetrofit,
+    duration: float,
+    trajectories: int,
+) -> str:
+    """A row of the mean statistics over ``trajectories`` unseen controls (seeds 0..K-1), with twice the standard
+    error of the difference over the trajectories."""
+    h = step_ms * 1e-3
+    pairs = []
+    for seed in range(trajectories):
+        control = unseen_control(coarse.model, duration, seed)
+        pairs.append(
+            (
+                stats(run(coarse.model, coarse.twin, control, duration, h).deviation),
+                stats(run(exact.model, exact.twin, control, duration, h).deviation),
+            )
+        )
+    c, e = (np.array([p[i] for p in pairs]) for i in (0, 1))
+    err = c.mean(axis=0) / e.mean(axis=0) - 1
+    both = 2 * np.hypot(c.std(axis=0, ddof=1), e.std(axis=0, ddof=1)) / math.sqrt(trajectories) / e.mean(axis=0)
+    return (
+        f"| {name} | {step_ms:g} | {band:g}' | unseen x {trajectories} (mean) | "
+        + " / ".join(f"{1e3 * x:.3g}" for x in c.mean(axis=0))
+        + " | "
+        + " / ".join(f"{1e3 * x:.3g}" for x in e.mean(axis=0))
+        + " | "
+        + " / ".join(f"{100 * x:+.0f} %" for x in err)
+        + " | "
+        + " / ".join(f"{100 * x:.0f} %" for x in both)
+        + " (over the trajectories) | | | | |"
+    )
+
+
 def cost(model: mujoco.MjModel, twin: mujoco.MjModel, step: float) -> tuple[float, float]:
     """Wall time per simulated second [s] of ``model`` and of ``twin`` at ``step`` (best of 3 alternating)."""
     best = [math.inf, math.inf]
@@ -208,7 +246,7 @@ def cost(model: mujoco.MjModel, twin: mujoco.MjModel, step: float) -> tuple[floa
     return best[0], best[1]
 
 
-def rows_for(name: str, spec: mujoco.MjSpec, step_ms: float, duration: float) -> list[str]:
+def rows_for(name: str, spec: mujoco.MjSpec, step_ms: float, duration: float, trajectories: int) -> list[str]:
     """The table's rows of one arm at one step."""
     hinges = actuated(spec)
     h = step_ms * 1e-3
@@ -243,6 +281,9 @@ def rows_for(name: str, spec: mujoco.MjSpec, step_ms: float, duration: float) ->
             f"{exact.model.opt.timestep:.2g} | {e.wall:.1f} |"
         )
         print(lines[-1], flush=True)
+    if trajectories > 1:
+        lines.append(ensemble_row(name, step_ms, band, coarse.retrofit, exact, duration, trajectories))
+        print(lines[-1], flush=True)
     mine, plain = cost(coarse.retrofit.model, coarse.retrofit.twin, h)
     lines.append(
         f"| {name} | {step_ms:g} | {band:g}' | cost | robot step {mine:.3f} s, unmodified {plain:.3f} s per simulated "
@@ -256,6 +297,12 @@ def main() -> None:
     """Run every arm at every step and write the table."""
     p = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     p.add_argument("--duration", type=float, default=6.0, help="seconds of each motion (default 6)")
+    p.add_argument(
+        "--trajectories",
+        type=int,
+        default=1,
+        help="unseen controls per row (seeds 0..K-1); K > 1 adds a row of their mean statistics (default 1)",
+    )
     p.add_argument("--arms", nargs="+", default=None, help="only these arms (default: all)")
     p.add_argument("--out", type=Path, default=OUT, help=f"the table (default {OUT.name} beside this script)")
     args = p.parse_args()
@@ -288,7 +335,7 @@ def main() -> None:
         if args.arms is not None and name not in args.arms:
             continue
         for step_ms in STEPS_MS:
-            body += rows_for(name, spec, step_ms, args.duration)
+            body += rows_for(name, spec, step_ms, args.duration, args.trajectories)
     tail = ["", f"Whole run {time.perf_counter() - t0:.0f} s."]
     command = " ".join([COMMAND, *sys.argv[1:]])
     head[3] = command
