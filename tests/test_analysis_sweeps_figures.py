@@ -303,7 +303,7 @@ def test_cli_refuses_unknown_quantity_and_reports_failed_points(tmp_path, capsys
     )
     assert rc == 1 and "1 of 1 points failed" in capsys.readouterr().err
     assert main_rank(["--joints", "no_such", "--out", str(tmp_path / "j")]) == 2
-    assert "['crank_rod', 'rod_slider']" in capsys.readouterr().err
+    assert "['crank_rod', 'rod_slider', 'slider_guide']" in capsys.readouterr().err  # a slider ranks too
 
 
 def test_cli_sweeps_and_ranks_the_press(tmp_path, monkeypatch, capsys):

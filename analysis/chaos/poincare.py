@@ -47,6 +47,7 @@ __all__ = [
     "quantity_series",
     "run_section",
     "RunSection",
+    "SLIDER_PARTS",
     "section_warning",
 ]
 
@@ -60,6 +61,10 @@ _JOINT_PARTS = {
     "vx": ("eccentricity_rate", 0),
     "vy": ("eccentricity_rate", 1),
 }
+
+SLIDER_PARTS = ("n", "vn", "tilt", "force")
+"""Parts of a slider with play that `quantity_series` samples (``<slider>.<part>``): across the
+guide, its rate, the tilt, the net contact-force magnitude."""
 
 
 class Regime(enum.Enum):
@@ -116,7 +121,9 @@ def quantity_series(result: SimulationResult, name: str) -> np.ndarray:
     Names: an output (``slider_x``, ``slider_x_vel``, ``slider_x_acc``), or
     ``<joint>.<part>`` for a clearance joint with part ``ex``, ``ey`` (eccentricity in the
     bearing frame [m]), ``vx``, ``vy`` (its rate [m/s]), ``e`` (|eccentricity| [m]),
-    ``force`` (contact-force magnitude [N]).
+    ``force`` (contact-force magnitude [N]); or ``<slider>.<part>`` for a slider with play in
+    its guide with part ``n`` (its position across the guide [m]), ``vn`` (its rate [m/s]),
+    ``tilt`` (its angle to the guide [rad]), ``force`` (net contact-force magnitude [N]).
 
     Raises:
         KeyError: unknown name.
@@ -133,9 +140,17 @@ def quantity_series(result: SimulationResult, name: str) -> np.ndarray:
             return np.hypot(jr.eccentricity[:, 0], jr.eccentricity[:, 1])
         if part == "force":
             return jr.force_magnitude
+    if joint in result.sliders and part in SLIDER_PARTS:
+        sr = result.sliders[joint]
+        if part == "force":
+            return np.hypot(sr.contact_force[:, 0], sr.contact_force[:, 1])
+        return sr.tilt if part == "tilt" else (sr.position if part == "n" else sr.velocity)[:, 1]
+    sliders = (
+        f" or '<slider>.<{'|'.join(SLIDER_PARTS)}>' with slider in {list(result.sliders)}" if result.sliders else ""
+    )
     raise KeyError(
         f"unknown quantity {name!r}: use an output {sorted(result.outputs)} or "
-        f"'<joint>.<ex|ey|vx|vy|e|force>' with joint in {list(result.joints)}"
+        f"'<joint>.<ex|ey|vx|vy|e|force>' with joint in {list(result.joints)}{sliders}"
     )
 
 

@@ -3,9 +3,10 @@
 A design point is ``{"clearances": {joint: c [m], ...}, **rest}``. `JointClearances` builds
 the base mechanism from ``rest`` (a builder's speed keyword, say) and gives each named joint
 its own radial clearance, keeping the rest of its `Clearance` record (bearing radius,
-materials, restitution, friction, law) or, for a joint the base leaves ideal, the record
-``template`` with that clearance. `FixedMechanism` serves a mechanism read from a file as a
-base, its first constant-speed drive set to the point's ``speed`` when one is given.
+materials, restitution, friction, law; a slider's `TranslationalClearance`, its play c) or,
+for a joint the base leaves ideal, the record ``template`` with that clearance.
+`FixedMechanism` serves a mechanism read from a file as a base, its first constant-speed
+drive set to the point's ``speed`` when one is given.
 """
 
 from __future__ import annotations
@@ -22,7 +23,7 @@ __all__ = ["FixedMechanism", "JointClearances", "with_clearances"]
 
 
 def with_clearances(mechanism: Mechanism, clearances: Mapping[str, float], template: Clearance) -> Mechanism:
-    """The mechanism with each named joint at its own radial clearance [m].
+    """The mechanism with each named joint at its own radial clearance [m] (a slider: its play c).
 
     Args:
         mechanism: the design (not changed: a new one is returned).
@@ -32,7 +33,8 @@ def with_clearances(mechanism: Mechanism, clearances: Mapping[str, float], templ
 
     Raises:
         KeyError: a name that is not a joint of the mechanism.
-        ValueError: a joint that is not revolute, or a clearance its bearing cannot hold.
+        ValueError: a prismatic joint without play in its guide in ``mechanism``, or a
+            clearance its bearing or guide cannot hold.
     """
     names = {j.name for j in mechanism.joints}
     unknown = [k for k in clearances if k not in names]
@@ -40,9 +42,15 @@ def with_clearances(mechanism: Mechanism, clearances: Mapping[str, float], templ
         raise KeyError(f"no joint {unknown} in mechanism '{mechanism.name}' (joints: {sorted(names)})")
     joints = []
     for j in mechanism.joints:
-        if j.name in clearances:
+        if j.name in clearances and j.translational_clearance is not None:  # a slider's play in its guide
+            play = dataclasses.replace(j.translational_clearance, clearance=float(clearances[j.name]))
+            j = dataclasses.replace(j, translational_clearance=play)
+        elif j.name in clearances:
             if j.kind is not JointType.REVOLUTE:
-                raise ValueError(f"joint '{j.name}' is not revolute: it cannot have a radial clearance")
+                raise ValueError(
+                    f"joint '{j.name}' is a slider without play in its guide: give it play in the base mechanism "
+                    "(clearance_at) to allocate it a clearance"
+                )
             base = j.clearance or dataclasses.replace(template, journal_link=None)
             j = dataclasses.replace(j, clearance=dataclasses.replace(base, radial_clearance=float(clearances[j.name])))
         joints.append(j)

@@ -259,8 +259,9 @@ def _report_lines(
     lines += lag_lines(joint_lag(result, ideal, output, startup=window.startup))
 
     lines += _deviation_lines(result, ideal, output, window, out)
-    if result.joints:
+    if result.joints or result.sliders:
         lines += contact_section(result, window, out)
+    if result.joints:
         lines += film_section(result, window, out)  # lubricated joints: the film beside the orbits
     if result.sliders:  # sliders with play: position and tilt in the guide, contact cases
         from clearance.analysis.figures.slider_figures import slider_section

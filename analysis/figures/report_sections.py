@@ -174,14 +174,14 @@ def contact_section(result: SimulationResult, window: Window, out: Path) -> list
     """The "Contact at the clearance joints" section; draws contact_modes.png, links contact_force.png and orbits.
 
     Args:
-        result: the run (with clearance joints).
+        result: the run (with clearance joints or sliders with play).
         window: its start-up window.
         out: folder of the report.
 
     Returns:
         The section's Markdown lines: start-up and steady-state statistics side by side.
     """
-    joints = list(result.joints)
+    joints = [*result.joints, *result.sliders]  # a slider with play: its deepest corner, its net force
     k = int(np.searchsorted(result.times, window.split))  # the first steady-state row
     parts: list[tuple[str, slice, dict[str, float]]]
     if window.startup > 0:
@@ -226,14 +226,19 @@ def contact_section(result: SimulationResult, window: Window, out: Path) -> list
         f"A contact event (penetration > 0 without a break) lasting at least {format_quantity(thr, 's')} (5 % of "
         "the drive "
         "period) is continuous contact, a shorter one an impact; an event is classified over its whole "
-        "duration and counted in the window it starts in. Shares are of the window's time.",
+        "duration and counted in the window it starts in. Shares are of the window's time."
+        + (
+            " A slider with play is in contact while any corner is: its penetration is the deepest corner's, its "
+            "force the net contact force on it (its corners and contact cases: the slider section)."
+            if result.sliders
+            else ""
+        ),
         "",
-        "![contact force](contact_force.png)",
-        "",
+        *(["![contact force](contact_force.png)", ""] if result.joints else []),
         "![contact modes](contact_modes.png)",
         "",
     ]
-    for j in joints:
+    for j in result.joints:
         lines += [f"![orbit {j}](orbit_{j}.png)", ""]
     return lines
 

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from clearance.analysis.metrics.statistics import drive_period
-from clearance.analysis.metrics.summary import JointSummary, joint_summary
+from clearance.analysis.metrics.summary import JointSummary, contact_series, joint_summary
 from clearance.results import SimulationResult
 
 __all__ = [
@@ -420,7 +420,7 @@ def contact_modes(
     skip: float | None = None,
     end: float | None = None,
 ) -> JointContactModes:
-    """Classify a clearance joint's contact as free flight, impacts or continuous contact.
+    """Classify a clearance joint's (or a slider's) contact as free flight, impacts or continuous contact.
 
     Events are found and classified over the whole run (an event that crosses the window's
     edge keeps the mode of its whole duration); the fractions, events and impulse are those
@@ -428,7 +428,7 @@ def contact_modes(
 
     Args:
         result: a run.
-        joint: clearance joint name.
+        joint: clearance joint name, or a slider with play (`summary.contact_series`).
         continuous_after: duration threshold [s]; default 5 % of the drive period.
         skip: start of the window after the run's start [s]; default 0 (the first impact
             is part of the behaviour).
@@ -438,11 +438,9 @@ def contact_modes(
     Raises:
         KeyError: unknown joint.
     """
-    if joint not in result.joints:
-        raise KeyError(f"no clearance joint {joint!r} (have {list(result.joints)})")
+    penetration, force = contact_series(result, joint)
     if continuous_after is None:
         continuous_after = CONTINUOUS_SHARE * drive_period(result)
-    jr = result.joints[joint]
     t = result.times
     h = _sample_interval(t)
     keep = t >= t[0] + (skip or 0.0)
@@ -451,10 +449,9 @@ def contact_modes(
     code = {ContactMode.FREE_FLIGHT: 0, ContactMode.IMPACT: 1, ContactMode.CONTINUOUS: 2}
     label = np.zeros(len(t), dtype=np.int8)  # each sample's mode (code), from its whole event
     events = []
-    force = jr.force_magnitude
     for e, a, b in zip(
-        contact_events(t, jr.penetration, force, continuous_after=continuous_after),
-        *_event_bounds(jr.penetration),
+        contact_events(t, penetration, force, continuous_after=continuous_after),
+        *_event_bounds(penetration),
     ):
         label[a : b + 1] = code[e.mode]
         if keep[a]:

@@ -14,7 +14,15 @@ import numpy as np
 
 from clearance.results import SimulationResult, atomic_write_text
 
-__all__ = ["JointSummary", "joint_summary", "rms_deviation", "summarise", "summary_of_series", "write_summary_csv"]
+__all__ = [
+    "JointSummary",
+    "contact_series",
+    "joint_summary",
+    "rms_deviation",
+    "summarise",
+    "summary_of_series",
+    "write_summary_csv",
+]
 
 
 @dataclass(frozen=True)
@@ -86,6 +94,34 @@ def rms_deviation(result: SimulationResult, ideal: SimulationResult, output: str
     return float(np.sqrt(np.mean((result.outputs[output][k0:] - ref) ** 2)))
 
 
+def contact_series(result: SimulationResult, joint: str) -> tuple[np.ndarray, np.ndarray]:
+    """Penetration and contact-force magnitude of a clearance joint or of a slider with play.
+
+    A slider counts as in contact while any corner is: its penetration is the deepest
+    corner's, its force the net contact force on the slider.
+
+    Args:
+        result: a run.
+        joint: one of its clearance joints (`SimulationResult.joints`) or sliders with play
+            (`SimulationResult.sliders`).
+
+    Returns:
+        penetration (n,) [m] (> 0 in contact) and force magnitude (n,) [N].
+
+    Raises:
+        KeyError: a name that is neither.
+    """
+    if joint in result.joints:
+        jr = result.joints[joint]
+        return jr.penetration, jr.force_magnitude
+    if joint in result.sliders:
+        sr = result.sliders[joint]
+        return sr.corner_penetration.max(axis=1), np.hypot(sr.contact_force[:, 0], sr.contact_force[:, 1])
+    raise KeyError(
+        f"no clearance joint or slider with play {joint!r} (have {list(result.joints)} and {list(result.sliders)})"
+    )
+
+
 def joint_summary(
     result: SimulationResult,
     joint: str,
@@ -98,7 +134,7 @@ def joint_summary(
 
     Args:
         result: a run.
-        joint: name of one of its clearance joints.
+        joint: name of one of its clearance joints or sliders with play (`contact_series`).
         deviation: RMS deviation of the output from ideal over the whole run, carried into the
             summary [m or rad].
         startup: start-up window [s]; > 0 adds the steady-state statistics after it.
@@ -108,12 +144,12 @@ def joint_summary(
     Returns:
         The joint's `JointSummary`.
     """
-    jr = result.joints[joint]
+    penetration, force = contact_series(result, joint)
     return summary_of_series(
         joint,
         result.times,
-        jr.penetration,
-        jr.force_magnitude,
+        penetration,
+        force,
         deviation=deviation,
         startup=startup,
         steady_deviation=steady_deviation,
@@ -191,19 +227,8 @@ def summarise(
         if (ideal is not None and outputs and startup > 0)
         else nan
     )
-    rows = [joint_summary(result, j, deviation=dev, startup=startup, steady_deviation=steady) for j in result.joints]
-    return rows + [
-        summary_of_series(
-            j,
-            result.times,
-            sr.corner_penetration.max(axis=1),
-            np.hypot(sr.contact_force[:, 0], sr.contact_force[:, 1]),
-            deviation=dev,
-            startup=startup,
-            steady_deviation=steady,
-        )
-        for j, sr in result.sliders.items()
-    ]
+    joints = [*result.joints, *result.sliders]
+    return [joint_summary(result, j, deviation=dev, startup=startup, steady_deviation=steady) for j in joints]
 
 
 def write_summary_csv(rows: list[JointSummary], path: str | Path) -> Path:

@@ -22,6 +22,8 @@ which is why orbits are logged relative to the bearing centre in micrometres):
   ``reactions/<joint>/ideal`` the ideal twin's magnitude (when given);
   ``mechanism/reactions``: the same forces as arrows from each joint (on link_b), scaled so
   that the run's largest reaction is 40 % of the mechanism's size (the scale is in the label).
+* ``sliders/<joint>/...``: a slider with play drawn in its guide with its contact case, and
+  its series (`slider_rerun`).
 * ``mechanism/links`` (line strips between each link's points), ``mechanism/joints`` and
   the static ``mechanism/ground`` [mm]. Only these are decimated to ``max_rate_hz`` rows
   per simulated second (a display rate); every other series is logged at full rate.
@@ -329,6 +331,18 @@ def log_run(
             logged.append(path)
 
     logged += _log_mechanism(recording, run, max_rate_hz)
+    if res.sliders:  # sliders with play: each drawn in its guide with its contact case
+        from clearance.analysis.recording.slider_rerun import log_sliders
+
+        logged += log_sliders(
+            recording,
+            result=res,
+            mechanism=mech,
+            path=run.path,
+            indexes=lambda rows: _indexes(res.times, res.drive_angle, rows),
+            rows=_display_rows(res.times, max_rate_hz),
+            tag=tag,
+        )
     return logged
 
 
@@ -470,12 +484,13 @@ def make_blueprint(runs: Sequence[LoggedRun]) -> rrb.Blueprint:
         name="mechanism [mm]", origin="/", contents=[f"+ {r.path('mechanism')}/**" for r in runs]
     )
     series = []
-    if joints:
+    if joints or any(r.result.sliders for r in runs):
         series.append(
             rrb.TimeSeriesView(
                 name="contact force [N]",
                 origin="/",
-                contents=[f"+ {r.path(f'joints/{j}')}/force/magnitude" for r in runs for j in r.result.joints],
+                contents=[f"+ {r.path(f'joints/{j}')}/force/magnitude" for r in runs for j in r.result.joints]
+                + [f"+ {r.path(f'sliders/{j}')}/force/magnitude" for r in runs for j in r.result.sliders],
             )
         )
     outputs = list(dict.fromkeys(o for r in runs for o in r.result.outputs if not o.endswith(("_vel", "_acc"))))
@@ -497,6 +512,11 @@ def make_blueprint(runs: Sequence[LoggedRun]) -> rrb.Blueprint:
     speeds = [f"+ {r.path(f'drives/{d}')}/speed" for r in runs for d in _drive_names(r)]
     if speeds:
         series.append(rrb.TimeSeriesView(name="drive speed [rad/s]", origin="/", contents=speeds))
+    from clearance.analysis.recording.slider_rerun import slider_views
+
+    drawings, slider_series = slider_views([(r.result, r.path) for r in runs])
+    orbit_views += drawings  # each slider in its guide beside the orbits
+    series += slider_series
     left = (
         rrb.Vertical(mech_view, rrb.Grid(*orbit_views) if len(orbit_views) > 1 else orbit_views[0])
         if orbit_views

@@ -2,9 +2,10 @@
 
 Following Alok, Chaudhary and Guha 2020 (docs/references.md), the candidates are all
 revolute joints except the driven crank's ground pivot and the output link's ground
-pivot. Each candidate gets the clearance alone, over a grid of clearances and drive
-speeds; the deviation of the first output from the ideal mechanism's is measured per
-drive period after the first (`statistics.per_cycle_mean_deviation`).
+pivot; with the exact contact, every slider's play in its guide is a candidate too. Each
+candidate gets the clearance alone, over a grid of clearances and drive speeds; the
+deviation of the first output from the ideal mechanism's is measured per drive period after
+the first (`statistics.per_cycle_mean_deviation`).
 
 Score of a joint: the mean over grid cells of (mean deviation / clearance), so every cell
 weighs alike whatever its clearance. Its unit follows the output's kind: dimensionless
@@ -29,7 +30,7 @@ import numpy as np
 
 from clearance.analysis.sweeps.sweep import MechanismFactory, SweepEvaluation, run_sweep
 from clearance.model import Mechanism, OutputKind
-from clearance.options import ModelOptions
+from clearance.options import ContactMode, ModelOptions
 
 __all__ = [
     "CellDeviation",
@@ -45,11 +46,13 @@ __all__ = [
 ]
 
 
-def criticality_candidates(mechanism: Mechanism) -> list[str]:
+def criticality_candidates(mechanism: Mechanism, *, sliders: bool = False) -> list[str]:
     """Revolute joints eligible for clearance: all but the driven and the output's ground pivot.
 
     Args:
         mechanism: a `Mechanism` (its first output defines the output link).
+        sliders: also every prismatic joint (a slider's play in its guide, a translational
+            clearance), in declaration order among the hinges.
     """
     from clearance.model import JointType
 
@@ -57,6 +60,9 @@ def criticality_candidates(mechanism: Mechanism) -> list[str]:
     out_link = mechanism.outputs[0].link if mechanism.outputs else None
     out = []
     for j in mechanism.joints:
+        if j.kind is JointType.PRISMATIC and sliders:
+            out.append(j.name)
+            continue
         if j.kind is not JointType.REVOLUTE or j.name in driven:
             continue
         if out_link is not None and {j.link_a, j.link_b} == {mechanism.ground, out_link}:
@@ -311,7 +317,8 @@ def run_criticality(
         clearances: radial clearances [m].
         speeds: drive speeds [rad/s].
         out_dir: sweep folder.
-        joints: joints to test; default `criticality_candidates`.
+        joints: joints to test; default `criticality_candidates`, with the sliders in the
+            exact contact mode (the ring modes' corners of a slider need a step of about 1 us).
         periods: drive periods per run (the first is skipped; the rest give the per-cycle
             values).
         output: output measured (default the mechanism's first).
@@ -336,8 +343,9 @@ def run_criticality(
         raise ValueError(
             f"output must be one of the outputs of mechanism '{probe.name}', {list(kinds)} (got {output!r})"
         )
-    if joints is None:
-        joints = criticality_candidates(probe)
+    if joints is None:  # a slider's play ranks with the exact contact (ring-mode corners need steps of ~1 us)
+        exact = (options or ModelOptions()).contact_mode is ContactMode.EXACT
+        joints = criticality_candidates(probe, sliders=exact)
     points = criticality_points(joints, clearances, speeds)
     out = run_sweep(
         points,

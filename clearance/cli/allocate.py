@@ -64,7 +64,11 @@ def allocate_parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--scenario", default=None, help="scenario file (.toml), instead of --mechanism (default: none)")
     p.add_argument(
-        "--joints", nargs="+", default=None, help="joints given a clearance (default: criticality candidates)"
+        "--joints",
+        nargs="+",
+        default=None,
+        help="joints given a clearance, a slider's prismatic joint among them (its play in its guide) "
+        "(default: criticality candidates)",
     )
     p.add_argument("--output", default=None, help="output measured (default the mechanism's first)")
     p.add_argument("--measure", default="mean", help="mean, rms or peak deviation from the ideal output (default mean)")
@@ -226,8 +230,8 @@ def _mechanism(args: argparse.Namespace) -> tuple[str, MechanismFactory, Mechani
     name = args.mechanism or "slider_crank"
     entry = catalogue_entry(name)
     args.allocation_table = {}
-    clearable = tuple(entry.info.clearable)
-    joints = tuple(args.joints) if args.joints else clearable
+    clearable = (*entry.info.clearable, *entry.info.sliders)  # a slider's play in its guide: c like a hinge's
+    joints = tuple(args.joints) if args.joints else tuple(entry.info.clearable)
     unknown = [j for j in joints if j not in clearable]
     if unknown:
         raise UsageError(f"--joints: {unknown} cannot carry a clearance in {name}; choose from {list(clearable)}")
@@ -251,12 +255,13 @@ def _problem(
 
     revolute = [j.name for j in mech.joints if j.kind is JointType.REVOLUTE]
     driven = {d.joint for d in mech.drives}
+    sliders = [j.name for j in base({}).translational_joints]  # sliders given play by the base
     joints = tuple(args.joints) if args.joints else tuple(_candidates(mech))
-    bad = [j for j in joints if j not in revolute or j in driven]
+    bad = [j for j in joints if (j not in revolute or j in driven) and j not in sliders]
     if bad or len(set(joints)) != len(joints) or not joints:
         raise UsageError(
             f"--joints {list(joints)}: give distinct revolute, undriven joints of {name}: "
-            f"{[j for j in revolute if j not in driven]}"
+            f"{[j for j in revolute if j not in driven]}{', or its sliders ' + str(sliders) if sliders else ''}"
         )
     outputs = {o.name: o.kind for o in mech.outputs}
     output = args.output or next(iter(outputs), None)

@@ -300,7 +300,8 @@ def check_clearance_at(joints: list[str] | None, mechanism: str, *, sliders: boo
     unknown = [j for j in joints if j not in clearable]
     if unknown:
         where = (
-            f" (a slider's play, at {', '.join(info.sliders)}, runs in 'clearance run' and 'reference', not here)"
+            f" (a slider's play, at {', '.join(info.sliders)}, is not taken by this command; 'run', 'reference', "
+            "'sweep', 'rank' and 'allocate' take it)"
             if info.sliders and not sliders
             else ""
         )

@@ -46,7 +46,14 @@ def rank_parser() -> argparse.ArgumentParser:
         help="drive speeds [rpm] (default the catalogue's low speed and the middle of its range: "
         "1000 and 3000 rpm, press 30 and 60 rpm)",
     )
-    p.add_argument("--joints", nargs="*", default=None, help="joints (default: all but driven/output ground pivots)")
+    p.add_argument(
+        "--joints",
+        nargs="*",
+        default=None,
+        help="joints, a slider's prismatic joint among them (its play in its guide at the same c) "
+        "(default: the revolute joints but the driven and output ground pivots, and with the exact contact "
+        "every slider)",
+    )
     p.add_argument(
         "--periods",
         type=bounded(int, "--periods", 3, why=""),
@@ -103,7 +110,7 @@ def _rank(args: argparse.Namespace, out: Path) -> int:
     from clearance.results import atomic_write_text
 
     entry = catalogue_entry(args.mechanism)
-    clearable = entry.info.clearable
+    clearable = (*entry.info.clearable, *entry.info.sliders)  # a slider's play in its guide ranks like a hinge's
     if args.joints is not None:
         unknown = [j for j in args.joints if j not in clearable]
         if unknown or not args.joints:

@@ -75,7 +75,11 @@ def sweep_parser() -> argparse.ArgumentParser:
         default=None,
         help="drive speed when sweeping clearance [rpm] (default the catalogue's high speed)",
     )
-    p.add_argument("--quantity", default=None, help="sampled quantity (default <first clearance joint>.ex)")
+    p.add_argument(
+        "--quantity",
+        default=None,
+        help="sampled quantity (default <first clearance joint>.ex, or <slider>.n: a slider's place across its guide)",
+    )
     p.add_argument(
         "--periods", type=bounded(int, "--periods", 2), default=60, help="drive periods per point (default 60)"
     )
@@ -137,7 +141,7 @@ def _sweep(args: argparse.Namespace, out: Path) -> int:
     from clearance.analysis.sweeps.sweep import KeywordFactory
 
     entry = catalogue_entry(args.mechanism)
-    check_clearance_at(args.clearance_at, args.mechanism)
+    check_clearance_at(args.clearance_at, args.mechanism, sliders=True)
     fixed: dict[str, object] = {} if args.clearance_at is None else {"clearance_at": tuple(args.clearance_at)}
     if args.parameter == "clearance":
         lo, hi, key = si(args.start or 0.01, "mm"), si(args.stop or 1.0, "mm"), "radial_clearance"
@@ -172,9 +176,12 @@ def _sweep(args: argparse.Namespace, out: Path) -> int:
     valid = quantities(probed)
     quantity = args.quantity
     if quantity is None:
-        if not probed.clearance_joints:
+        if probed.clearance_joints:
+            quantity = f"{probed.clearance_joints[0].name}.ex"
+        elif probed.translational_joints:  # a slider's play: its position across the guide
+            quantity = f"{probed.translational_joints[0].name}.n"
+        else:
             return usage_error("the mechanism has no clearance joint; give --clearance-at or --quantity")
-        quantity = f"{probed.clearance_joints[0].name}.ex"
     elif quantity not in valid:
         return usage_error(f"--quantity {quantity!r} is not a quantity of {args.mechanism}; choose one of {valid}")
     from clearance.analysis.figures.analysis_figures import plot_bifurcation

@@ -200,5 +200,8 @@ def report_failures(failed: int, total: int, first: str, out: Path) -> int:
 
 def quantities(mechanism: Mechanism) -> list[str]:
     """Names `chaos.quantity_series` accepts for a mechanism's runs."""
+    from clearance.analysis.chaos.poincare import SLIDER_PARTS
+
     names = [f"{o.name}{s}" for o in mechanism.outputs for s in ("", "_vel", "_acc")]
-    return names + [f"{j.name}.{part}" for j in mechanism.clearance_joints for part in _JOINT_PARTS]
+    names += [f"{j.name}.{part}" for j in mechanism.clearance_joints for part in _JOINT_PARTS]
+    return names + [f"{j.name}.{part}" for j in mechanism.translational_joints for part in SLIDER_PARTS]
