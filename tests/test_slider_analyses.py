@@ -93,6 +93,10 @@ def test_rank_takes_a_slider_as_a_candidate_joint(tmp_path, capsys):
     # slider's position 4.2 times the guide's (3 us and 1.5 us alike): the ranking puts it first
     assert ranked[:2] == ["rod_slider", JOINT]
     assert JOINT in capsys.readouterr().out
+    # each point's row carries the played joint's contact summary, the slider's too
+    rows = [json.loads(p.read_text()) for p in (out / "points").glob("point_*.json")]
+    slider_row = next(r for r in rows if r["point"]["joint"] == JOINT)
+    assert list(slider_row["summary"]) == [JOINT] and slider_row["summary"][JOINT]["impacts"] > 0
 
 
 def test_allocation_gives_a_slider_its_own_play(tmp_path, capsys):

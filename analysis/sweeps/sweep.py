@@ -124,7 +124,7 @@ class SweepEvaluation:
         output = self.output or mechanism.outputs[0].name
         skip = self.skip_periods * period
         row: dict[str, Any] = {"period": period}
-        row["summary"] = {j: _summary_dict(joint_summary(result, j)) for j in result.joints}
+        row["summary"] = {j: _summary_dict(joint_summary(result, j)) for j in (*result.joints, *result.sliders)}
         if ideal is not None:
             row["statistics"] = deviation_statistics(result, ideal, output, skip=skip).as_dict()
             row["per_cycle_mean_deviation"] = per_cycle_mean_deviation(
