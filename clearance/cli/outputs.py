@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import math
 import os
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -19,6 +19,7 @@ if TYPE_CHECKING:
     from clearance.analysis.metrics.film import FilmSummary
     from clearance.analysis.metrics.reactions import ReactionSummary
     from clearance.analysis.metrics.summary import JointSummary
+    from clearance.run.simulation import SimulationError
 
 __all__ = [
     "write_outputs",
@@ -30,6 +31,7 @@ __all__ = [
     "duration_from_args",
     "duration_source",
     "check_output_paths",
+    "run_with_twin",
 ]
 
 
@@ -45,6 +47,45 @@ def check_output_paths(args: argparse.Namespace) -> Path:
     if getattr(args, "rerun", None) is not None:
         check_file(args.rerun, "--rerun", example="run.rrd")
     return out
+
+
+def run_with_twin(
+    run: Callable[[], SimulationResult], twin: Callable[[], SimulationResult], *, twin_name: str
+) -> tuple[SimulationResult, SimulationResult, SimulationError | None] | None:
+    """Run a model, then its twin, as the run commands do; None (after printing why) when there is
+    nothing to write.
+
+    A run that stops (`clearance.run.simulation.SimulationError`) keeps what it computed: its
+    partial result is returned with the error, for the outputs and the closing error line. A stop
+    with no rows, or a twin that stops, is printed as one error line.
+
+    Args:
+        run: simulates the model.
+        twin: simulates its twin (the deviations need all of it).
+        twin_name: what the twin is, for its error line ("the ideal twin (no clearance)").
+
+    Returns:
+        (result, twin's result, the run's stop or None), or None.
+    """
+    import sys
+
+    from clearance.run.simulation import SimulationError
+
+    failed = None
+    try:
+        result = run()
+    except SimulationError as err:
+        failed, partial = err, err.partial
+        if partial is None:
+            print(f"error: {failed}", file=sys.stderr)
+            return None
+        result = partial
+    try:
+        other = twin()
+    except SimulationError as err:
+        print(f"error: {twin_name}, needed for the deviations: {err}", file=sys.stderr)
+        return None
+    return result, other, failed
 
 
 @contextmanager

@@ -19,6 +19,7 @@ from clearance.cli.outputs import (
     check_output_paths,
     duration_from_args,
     duration_source,
+    run_with_twin,
     write_outputs,
     writing_outputs,
 )
@@ -90,7 +91,7 @@ def _segments(segments: dict[str, int]) -> str:
 def _run(args: argparse.Namespace, mech: Mechanism, options: ModelOptions, duration: float, out: Path) -> int:
     from clearance.results import atomic_write_text
     from clearance.run.preparation import prepare
-    from clearance.run.simulation import SimulationError, simulate_prepared
+    from clearance.run.simulation import simulate_prepared
 
     started = time.time()
     prepared = prepare(mech, options)
@@ -108,20 +109,14 @@ def _run(args: argparse.Namespace, mech: Mechanism, options: ModelOptions, durat
     for line in calibration_lines(prepared.metadata.get("contact", {}), started):
         print(line)
     progress = not args.no_progress
-    failed = None
-    try:
-        result = simulate_prepared(prepared, duration=duration, progress=progress)
-    except SimulationError as err:
-        failed, partial = err, err.partial
-        if partial is None:
-            print(f"error: {failed}", file=sys.stderr)
-            return 2
-        result = partial
-    try:
-        ideal = simulate_prepared(ideal_prepared, duration=duration, progress=progress)
-    except SimulationError as err:
-        print(f"error: the ideal twin (no clearance), needed for the deviations: {err}", file=sys.stderr)
+    runs = run_with_twin(
+        lambda: simulate_prepared(prepared, duration=duration, progress=progress),
+        lambda: simulate_prepared(ideal_prepared, duration=duration, progress=progress),
+        twin_name="the ideal twin (no clearance)",
+    )
+    if runs is None:
         return 2
+    result, ideal, failed = runs
     with writing_outputs(out, args.rerun) as (stage, recording):
         atomic_write_text(stage / "model.xml", prepared.to_xml())
         atomic_write_text(stage / "ideal_model.xml", ideal_prepared.to_xml())

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from clearance.cli.outputs import writing_outputs
+from clearance.cli.outputs import run_with_twin, writing_outputs
 from clearance.result_units import result_units
 from clearance.units import format_quantity as q
 
@@ -88,24 +88,17 @@ def run_and_write(
     from clearance.analysis.metrics.summary import write_summary_csv
     from clearance.retrofit import SineControl
     from clearance.run.retrofitted import simulate_retrofitted
-    from clearance.run.simulation import SimulationError
 
     _header(loaded, duration, startup, interval)
     every = EveryStep()
-    failed = None
-    try:
-        result = simulate_retrofitted(loaded, drive, duration, sites=sites, output_interval=interval, every_step=every)
-    except SimulationError as err:
-        failed, partial = err, err.partial
-        if partial is None:
-            print(f"error: {failed}", file=sys.stderr)
-            return 2
-        result = partial
-    try:
-        twin = simulate_retrofitted(loaded, drive, duration, twin=True, sites=sites, output_interval=interval)
-    except SimulationError as err:
-        print(f"error: the unmodified twin, needed for the deviations: {err}", file=sys.stderr)
+    runs = run_with_twin(
+        lambda: simulate_retrofitted(loaded, drive, duration, sites=sites, output_interval=interval, every_step=every),
+        lambda: simulate_retrofitted(loaded, drive, duration, twin=True, sites=sites, output_interval=interval),
+        twin_name="the unmodified twin",
+    )
+    if runs is None:
         return 2
+    result, twin, failed = runs
     stopped = None if failed is None else str(failed)
     if stopped is not None:
         result.metadata["stopped"] = stopped
