@@ -2,7 +2,7 @@
 
 Following Alok, Chaudhary and Guha 2020 (docs/references.md), the candidates are all
 revolute joints except the driven crank's ground pivot and the output link's ground
-pivot; with the exact contact, every slider's play in its guide is a candidate too. Each
+pivot; asked to, every slider's play in its guide is a candidate too (`clearance rank`). Each
 candidate gets the clearance alone, over a grid of clearances and drive speeds; the
 deviation of the first output from the ideal mechanism's is measured per drive period after
 the first (`statistics.per_cycle_mean_deviation`).
@@ -30,7 +30,7 @@ import numpy as np
 
 from clearance.analysis.sweeps.sweep import MechanismFactory, SweepEvaluation, run_sweep
 from clearance.model import Mechanism, OutputKind
-from clearance.options import ContactMode, ModelOptions
+from clearance.options import ModelOptions
 
 __all__ = [
     "CellDeviation",
@@ -298,6 +298,7 @@ def run_criticality(
     speeds: Sequence[float],
     out_dir: str | Path,
     joints: Sequence[str] | None = None,
+    sliders: bool = False,
     periods: int = 6,
     output: str | None = None,
     options: ModelOptions | None = None,
@@ -317,8 +318,9 @@ def run_criticality(
         clearances: radial clearances [m].
         speeds: drive speeds [rad/s].
         out_dir: sweep folder.
-        joints: joints to test; default `criticality_candidates`, with the sliders in the
-            exact contact mode (the ring modes' corners of a slider need a step of about 1 us).
+        joints: joints to test; default `criticality_candidates`.
+        sliders: with ``joints`` None, also every slider's play in its guide (the revolute
+            rule alone is the published one: Alok, Chaudhary and Guha 2020).
         periods: drive periods per run (the first is skipped; the rest give the per-cycle
             values).
         output: output measured (default the mechanism's first).
@@ -343,9 +345,8 @@ def run_criticality(
         raise ValueError(
             f"output must be one of the outputs of mechanism '{probe.name}', {list(kinds)} (got {output!r})"
         )
-    if joints is None:  # a slider's play ranks with the exact contact (ring-mode corners need steps of ~1 us)
-        exact = (options or ModelOptions()).contact_mode is ContactMode.EXACT
-        joints = criticality_candidates(probe, sliders=exact)
+    if joints is None:
+        joints = criticality_candidates(probe, sliders=sliders)
     points = criticality_points(joints, clearances, speeds)
     out = run_sweep(
         points,

@@ -51,8 +51,7 @@ def rank_parser() -> argparse.ArgumentParser:
         nargs="*",
         default=None,
         help="joints, a slider's prismatic joint among them (its play in its guide at the same c) "
-        "(default: the revolute joints but the driven and output ground pivots, and with the exact contact "
-        "every slider)",
+        "(default: the revolute joints but the driven and output ground pivots, and every slider)",
     )
     p.add_argument(
         "--periods",
@@ -149,6 +148,7 @@ def _rank(args: argparse.Namespace, out: Path) -> int:
                 clearances=clearances,
                 speeds=speeds,
                 joints=args.joints,
+                sliders=True,  # a slider's play in its guide is a candidate like a hinge's
                 out_dir=out,
                 periods=args.periods,
                 options=options,
