@@ -180,3 +180,13 @@ def test_rerun_draws_the_slider_in_its_guide_with_its_contact_case(run, tmp_path
     assert np.array_equal(_squeeze(data[(f"{base}/across", False)]["Scalars:scalars"]), sr.position[:, 1] * 1e6)
     assert np.array_equal(_squeeze(data[(f"{base}/contact_case", False)]["Scalars:scalars"]), sr.contact_case)
     assert {f"{JOINT} in its guide [mm, guide frame]", "contact force [N]"} <= _view_names(blueprints)
+
+
+def test_run_digest_keeps_the_slider(run):
+    from clearance.analysis.sweeps.run_store import digest_result
+
+    _, res = run
+    d = digest_result("s", res, 2e-3).joints[JOINT]
+    _, force = contact_series(res, JOINT)
+    assert d["steady_peak_force"] == force[res.times >= 2e-3].max() > 0  # the same samples, the same max
+    assert d["impacts"] == joint_summary(res, JOINT).impacts

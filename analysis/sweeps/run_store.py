@@ -88,7 +88,7 @@ class RunDigest:
         outputs: output name (also ``_vel``/``_acc``) -> ``{"max", "min", "max_abs",
             "steady_max_abs"}`` [SI units of the output]; ``steady_`` values over t >=
             window_start.
-        joints: clearance joint -> `JointSummary` fields over the whole run, plus
+        joints: clearance joint or slider with play -> `JointSummary` fields over the whole run, plus
             ``steady_peak_force`` and ``steady_p95_force`` [N] over t >= window_start.
         wall_time_s: simulation wall time [s].
         steps: steps simulated.
@@ -112,7 +112,7 @@ def digest_result(name: str, result: SimulationResult, window_start: float) -> R
         result: the run, every step kept.
         window_start: start of the steady window [s].
     """
-    from clearance.analysis.metrics.summary import joint_summary
+    from clearance.analysis.metrics.summary import contact_series, joint_summary
 
     steady = result.times >= window_start
     outs = {}
@@ -125,12 +125,13 @@ def digest_result(name: str, result: SimulationResult, window_start: float) -> R
             "steady_max_abs": float(a[steady].max()) if steady.any() else float("nan"),
         }
     joints = {}
-    for j, jr in result.joints.items():
+    for j in (*result.joints, *result.sliders):  # a slider: its deepest corner, its net force
         d = asdict(joint_summary(result, j))
         d.pop("joint")
         d.pop("output_rms_deviation")
-        f = jr.force_magnitude[steady]
-        on = jr.penetration[steady] > 0
+        penetration, force = contact_series(result, j)
+        f = force[steady]
+        on = penetration[steady] > 0
         d["steady_peak_force"] = float(f.max()) if len(f) else 0.0
         d["steady_p95_force"] = float(np.percentile(f[on], 95)) if on.any() else 0.0
         joints[j] = d
