@@ -22,7 +22,10 @@ the ideal twin's ``y_ideal``:
   cycles of the per-cycle mean |y - y_ideal| (`per_cycle_mean_deviation`);
 - ``rms_deviation``: sqrt(mean((y - y_ideal)^2));
 - ``peak_deviation``: max |y - y_ideal|;
-- ``peak_force``: the largest contact force magnitude of any clearance joint [N].
+- ``peak_force``: the largest contact force magnitude of any clearance joint or slider with
+  play (the net force on it) [N].
+
+A slider with play starts centred in its guide in every run (start states offset journals).
 
 Runs are picklable tasks (a mechanism factory, a point, a start state, the settings) sent
 to the sweeps' executor (`open_executor`: a ``spawn`` process pool, a Dask cluster or the
@@ -273,6 +276,7 @@ def simulated_measures(mechanism: Mechanism, start: StartState, settings: Ensemb
         ValueError: the mechanism has no drive with a set period, or not the output.
     """
     from clearance.analysis.metrics.statistics import deviation_statistics, per_cycle_mean_deviation
+    from clearance.analysis.metrics.summary import contact_series
     from clearance.analysis.sweeps.ideal_runs import ideal_run
     from clearance.run.simulation import simulate
 
@@ -286,7 +290,9 @@ def simulated_measures(mechanism: Mechanism, start: StartState, settings: Ensemb
     cycles = per_cycle_mean_deviation(res, ideal, output, period=period, skip=period)
     stats = deviation_statistics(res, ideal, output, skip=period)
     steady = res.times >= res.times[0] + period
-    forces = {j: float(jr.force_magnitude[steady].max()) if steady.any() else 0.0 for j, jr in res.joints.items()}
+    forces = {  # a slider with play: the net contact force on it
+        j: float(contact_series(res, j)[1][steady].max()) if steady.any() else 0.0 for j in (*res.joints, *res.sliders)
+    }
     return {
         "mean_deviation": float(cycles.mean()),
         "rms_deviation": stats.rms_deviation,
