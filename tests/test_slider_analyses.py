@@ -49,6 +49,11 @@ def test_quantities_of_a_slider_are_its_own_series(run):
     with pytest.raises(KeyError, match=r"'<slider>\.<n\|vn\|tilt\|force>' with slider in \['slider_guide'\]"):
         quantity_series(res, f"{JOINT}.ex")
     assert SLIDER_PARTS == ("n", "vn", "tilt", "force")
+    from clearance.analysis.figures.analysis_figures import quantity_label
+
+    # a bifurcation diagram's axis: the slider across its guide in µm, not the default mm
+    assert quantity_label(f"{JOINT}.n") == (f"{JOINT} across the guide", "µm", 1e6)
+    assert quantity_label(f"{JOINT}.tilt")[1:] == ("µrad", 1e6)
 
 
 def test_sweep_samples_the_slider_across_its_guide(tmp_path):

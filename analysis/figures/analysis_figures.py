@@ -51,7 +51,8 @@ _PARAMS = {
 def quantity_label(name: str) -> tuple[str, str, float]:
     """(label, unit, scale from SI) of a quantity or output name, for axes.
 
-    Joint parts ``.ex/.ey/.e`` are shown in µm, ``.vx/.vy`` in mm/s, ``.force`` in N;
+    Joint parts ``.ex/.ey/.e`` are shown in µm, ``.vx/.vy`` in mm/s, ``.force`` in N; a
+    slider's ``.n`` in µm, ``.vn`` in mm/s, ``.tilt`` in µrad;
     outputs ending in ``_vel``/``_acc`` in m/s and m/s², other outputs in mm (angles named
     ``*angle*`` in rad). Sweep parameters: clearance in mm, speed in rpm.
     """
@@ -66,6 +67,9 @@ def quantity_label(name: str) -> tuple[str, str, float]:
             "vx": ("eccentricity rate x", "mm/s", 1e3),
             "vy": ("eccentricity rate y", "mm/s", 1e3),
             "force": ("contact force", "N", 1.0),
+            "n": ("across the guide", "µm", 1e6),  # a slider with play (chaos.SLIDER_PARTS)
+            "vn": ("rate across the guide", "mm/s", 1e3),
+            "tilt": ("tilt", "µrad", 1e6),
         }
         if part in units:
             lab, unit, scale = units[part]
