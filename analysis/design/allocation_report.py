@@ -112,7 +112,8 @@ def allocation_markdown(a: Allocation, *, title: str, unit: str, scale: float, c
     lines += [
         "",
         f"Cost per joint a + b / (c / 1 mm). Target: {p.target_share:.0%} of the verification runs within budget. "
-        f"Verification ensembles: {v.runs} runs, start offsets uniform in discs of {v.spread:.2%} of each clearance, "
+        f"Verification ensembles: {v.runs} runs, journals' start offsets uniform in discs of {v.spread:.2%} of each "
+        "clearance (a slider with play starts centred in its guide), "
         f"seed {v.seed}, {v.periods} drive periods per run (the first is start-up and not measured).",
         "",
         "## Allocation",
