@@ -179,7 +179,7 @@ def main() -> None:
 
 def figure(ratios: dict[tuple[float, float], float]) -> None:
     """Left: the output's deviation over time at `FIGURE_CELL`; right: the mean-deviation ratio per cell."""
-    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.2))
+    fig, (ax, bx) = plt.subplots(1, 2, figsize=(12, 4.6))
     c_mm, rpm = FIGURE_CELL
     for joint, color in zip(JOINTS, ("C0", "C3"), strict=True):
         res, ideal = run(joint, c_mm, rpm)
@@ -191,7 +191,7 @@ def figure(ratios: dict[tuple[float, float], float]) -> None:
         ylabel="slider_x - ideal [µm]",
         title=f"slider-crank, c = {c_mm:g} mm at one joint, {rpm:g} rpm",
     )
-    ax.legend(loc="lower right", fontsize=8)
+    ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.14), ncol=2, fontsize=8)
     for rpm_i, marker in zip(SPEEDS_RPM, ("o", "s", "^"), strict=True):
         bx.plot(CLEARANCES_MM, [ratios[(c, rpm_i)] for c in CLEARANCES_MM], marker=marker, label=f"{rpm_i:g} rpm")
     bx.axhline(1.0, color="0.5", lw=0.8)
