@@ -310,6 +310,27 @@ def _statistics_section(steps: Sequence[float], refs: References) -> list[str]:
     return lines
 
 
+def _slider_section() -> list[str]:
+    """The compiled slider-guide contact's order on the published slider-crank with play in its guide
+    (`translational_clearance_mujoco.convergence_rows`: its first episode, 0-20 ms)."""
+    import translational_clearance_mujoco as guide  # benchmarks/translational_clearance_mujoco.py
+
+    from clearance.builders.scenario import load_scenario
+
+    return [
+        "## The slider in its guide (the compiled slider-guide contact)",
+        "",
+        "The Flores, Leine and Glocker (2010) slider-crank with play in its guide "
+        f"(`{guide.SCENARIO.relative_to(Path(__file__).resolve().parents[1])}`), the exact contact against the "
+        "reference over its first episode (0-20 ms): the largest |across - reference's| / c of the slider's path "
+        "across the guide, the first impact's peak corner force (relative) and the tilt rate at 4 ms (relative); "
+        "its own reference floor (rtol 1e-9 against 1e-11) and observed order as above.",
+        "",
+        *guide.convergence_rows(load_scenario(guide.SCENARIO)),
+        "",
+    ]
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=(__doc__ or "").split("\n\n")[0])
     ap.add_argument("--out", default="benchmarks/convergence.md")
@@ -335,6 +356,8 @@ def main() -> None:
     body += _ring_section(RING_STEPS_US, refs, effect)
     print("statistics", flush=True)
     body += _statistics_section(args.steps_us, refs)
+    print("slider in its guide", flush=True)
+    body += _slider_section()
     head = [
         "# Convergence with the time step: every contact mode and law against the reference",
         "",
