@@ -227,3 +227,16 @@ def test_result_units_cover_every_array_kind():
     assert array_unit("output/rocker_angle_vel", ["rocker_angle"]) == "rad/s"
     assert array_unit("output/slider_x_vel") == "m/s"
     assert array_unit("energy/kinetic") == "J" and array_unit("drive_torque") == "N m"
+
+
+def test_a_warning_met_at_every_compile_is_printed_once(tmp_path, capsys):
+    """A model with MuJoCo's deprecated settotalmass warns at each of the retrofit's compiles: one line."""
+    from retrofit_models import TOTALMASS_ARM
+
+    from clearance.cli import main
+
+    xml = tmp_path / "arm.xml"
+    xml.write_text(TOTALMASS_ARM)
+    main(["retrofit", str(xml), "--joint", "hip", "--contact-mode", "exact", "--out", str(tmp_path / "out")])
+    err = capsys.readouterr().err
+    assert err.count("'settotalmass' is deprecated") == 1, err

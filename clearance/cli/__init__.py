@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import argparse
 import atexit
+import functools
 import gc
 import importlib
 import sys
@@ -97,9 +98,16 @@ def _show_warning(
     lineno: int,
     file: TextIO | None = None,
     line: str | None = None,
+    *,
+    shown: set[str],
 ) -> None:
-    """Warnings as one line on stderr (``warning: ...``), without the source location."""
-    print(f"warning: {message}", file=sys.stderr)
+    """Warnings as one line on stderr (``warning: ...``), without the source location, each text once
+    per command (``shown``: the texts already printed; MuJoCo warns at every compile of a model, e.g.
+    of its deprecated ``settotalmass``, and a retrofit compiles the model several times)."""
+    text = str(message)
+    if text not in shown:
+        shown.add(text)
+        print(f"warning: {text}", file=sys.stderr)
 
 
 def main(argv: list[str] | None = None) -> int:
@@ -116,7 +124,7 @@ def main(argv: list[str] | None = None) -> int:
         atexit.register(gc.freeze)
     argv = list(sys.argv[1:] if argv is None else argv)
     with warnings.catch_warnings():
-        warnings.showwarning = _show_warning
+        warnings.showwarning = functools.partial(_show_warning, shown=set())
         try:
             return _dispatch(argv)
         except KeyboardInterrupt:
