@@ -189,16 +189,32 @@ static void sg_evaluate(const mjModel* m, mjData* d, sgData* c, const mjtNum* s,
   // own responses (with the equality constraints), other forces and kinematic forcing
   mjtNum Wnn[SG_NC * SG_NC] = {0}, Wnt[SG_NC * SG_NC] = {0}, wtt[SG_NC] = {0};
   mjtNum other_n[SG_NC] = {0}, other_t[SG_NC] = {0}, kin[SG_NC] = {0};
-  if (instep) {
-    mj_solveM(m, d, c->resp, c->rows, 2 * SG_NC);
+  // the responses enter only through forces, and only a loaded corner (inside its line, or carrying
+  // a friction force from the last step) has one this step: its normal and tangential rows are
+  // solved, the others' are not needed (their columns of W multiply forces that are 0), so a slider
+  // in free flight solves nothing and one landing on two corners half its rows; the same results
+  int loaded[SG_NC], nloaded = 0;
+  for (int k = 0; k < SG_NC; k++) {
+    loaded[k] = ev->delta[k] > 0 || (last && s[G_CORNER + SG_CS * k + K_FT] != 0);
+    nloaded += loaded[k];
+  }
+  if (instep && nloaded) {
     int neq = cl_equality_factor(m, d, &c->eq);
-    for (int r = 0; neq && r < 2 * SG_NC; r++) cl_constrain(&c->eq, neq, nv, c->resp + r * nv);
-    for (int k = 0; k < SG_NC; k++) {
-      for (int l = 0; l < SG_NC; l++) {
+    for (int l = 0; l < SG_NC; l++) {
+      if (!loaded[l]) continue;
+      for (int r = l; r < 2 * SG_NC; r += SG_NC) {
+        mj_solveM(m, d, c->resp + r * nv, c->rows + r * nv, 1);
+        if (neq) cl_constrain(&c->eq, neq, nv, c->resp + r * nv);
+      }
+      for (int k = 0; k < SG_NC; k++) {
         Wnn[k * SG_NC + l] = mju_dot(c->rows + k * nv, c->resp + l * nv, nv);
         Wnt[k * SG_NC + l] = mju_dot(c->rows + k * nv, c->resp + (SG_NC + l) * nv, nv);
       }
-      wtt[k] = mju_dot(c->rows + (SG_NC + k) * nv, c->resp + (SG_NC + k) * nv, nv);
+      wtt[l] = mju_dot(c->rows + (SG_NC + l) * nv, c->resp + (SG_NC + l) * nv, nv);
+    }
+  }
+  if (instep) {
+    for (int k = 0; k < SG_NC; k++) {
       if (last) {
         other_n[k] = mju_dot(c->rows + k * nv, s + G_CORNER + SG_NC * SG_CS, nv);
         other_t[k] = mju_dot(c->rows + (SG_NC + k) * nv, s + G_CORNER + SG_NC * SG_CS, nv);
@@ -293,6 +309,7 @@ static void sg_evaluate(const mjModel* m, mjData* d, sgData* c, const mjtNum* s,
   if (instep) {  // the own velocity change over the step, h M^-1 sum(J' f)
     mju_zero(c->own, nv);
     for (int k = 0; k < SG_NC; k++) {
+      if (!loaded[k]) continue;
       mju_addToScl(c->own, c->resp + k * nv, -h * ev->fn[k], nv);
       mju_addToScl(c->own, c->resp + (SG_NC + k) * nv, h * ev->ft[k], nv);
     }
