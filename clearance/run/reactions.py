@@ -30,7 +30,7 @@ import numpy as np
 
 from clearance.model import Mechanism
 
-__all__ = ["ReactionLayout", "reaction_layout", "read_reactions", "rotate"]
+__all__ = ["frame_rate", "ReactionLayout", "reaction_layout", "read_reactions", "rotate"]
 
 
 @dataclass(frozen=True)
@@ -190,6 +190,19 @@ def rotate(xaxis: np.ndarray, v: np.ndarray) -> np.ndarray:
     """Vectors ``v`` (n, 2) given in frames whose x axes are ``xaxis`` (n, >=2), in the world."""
     c, s = xaxis[:, 0], xaxis[:, 1]
     return np.stack([c * v[:, 0] - s * v[:, 1], s * v[:, 0] + c * v[:, 1]], axis=1)
+
+
+def frame_rate(xaxis: np.ndarray, dv: np.ndarray, spin: np.ndarray, p: np.ndarray) -> np.ndarray:
+    """The rate of p = Rᵀ (x_a − x_b), a point's position in a turning frame, (n, 2).
+
+    p' = Rᵀ (v_a − v_b) + ω (p_y, −p_x), with R the frame's rotation (x axis ``xaxis`` (n, >=2)),
+    ``dv`` (n, 2) the two points' world velocity difference and ``spin`` (n,) the frame's angular
+    velocity ω: a journal's eccentricity rate in its bearing, a slider's velocity in its guide.
+    """
+    c, s = xaxis[:, 0], xaxis[:, 1]
+    return np.stack(
+        [c * dv[:, 0] + s * dv[:, 1] + spin * p[:, 1], -s * dv[:, 0] + c * dv[:, 1] - spin * p[:, 0]], axis=1
+    )
 
 
 def read_reactions(

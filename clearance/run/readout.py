@@ -24,7 +24,7 @@ from clearance.model import OutputKind
 from clearance.results import JointResult, SimulationResult
 from clearance.run.energy import read_energy
 from clearance.run.preparation import PreparedModel, exact_contact_name
-from clearance.run.reactions import reaction_layout, read_reactions, rotate
+from clearance.run.reactions import frame_rate, reaction_layout, read_reactions, rotate
 from clearance.run.slider_readout import read_sliders
 
 __all__ = ["read_sensors", "sensor_slices"]
@@ -130,11 +130,7 @@ def read_sensors(
         bx = get(f"{jname}__bxaxis")
         c, s = bx[:, 0], bx[:, 1]
         dv = get(f"{jname}__jvel")[:, :2] - get(f"{jname}__bvel")[:, :2]
-        w = get(f"{jname}__bangvel")[:, 2]
-        # e = R^T (p_j - p_b)  =>  e' = R^T (v_j - v_b) + w (e_y, -e_x)
-        erate = np.stack(
-            [c * dv[:, 0] + s * dv[:, 1] + w * e[:, 1], -s * dv[:, 0] + c * dv[:, 1] - w * e[:, 0]], axis=1
-        )
+        erate = frame_rate(bx, dv, get(f"{jname}__bangvel")[:, 2], e)  # e = R^T (p_j - p_b)
         film = None
         if prepared.built.exact_contact:
             oiled = mech.joint(jname).require_clearance().lubrication is not None

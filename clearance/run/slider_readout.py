@@ -25,7 +25,7 @@ import numpy as np
 
 from clearance.contact_plugin.slider_guide import slider_sensor_offsets
 from clearance.run.preparation import PreparedModel, exact_contact_name
-from clearance.run.reactions import rotate
+from clearance.run.reactions import frame_rate, rotate
 from clearance.translational import CORNERS, SliderResult, classify_contact
 
 __all__ = ["read_sliders"]
@@ -56,9 +56,7 @@ def read_sliders(
         c, s = gx[:, 0], gx[:, 1]
         dv = get(f"{joint}__svel")[:, :2] - get(f"{joint}__gvel")[:, :2]
         wg = get(f"{joint}__gangvel")[:, 2]
-        vel = np.stack(
-            [c * dv[:, 0] + s * dv[:, 1] + wg * pos[:, 1], -s * dv[:, 0] + c * dv[:, 1] - wg * pos[:, 0]], axis=1
-        )
+        vel = frame_rate(gx, dv, wg, pos)
         across = (
             pos[:, 1:2]
             + fu * play.slider_length * np.sin(tilt)[:, None]
