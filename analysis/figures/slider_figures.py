@@ -60,7 +60,7 @@ def plot_slider(result: SimulationResult, joint: str, *, path: str | Path | None
         ax[0].plot(t, sr.position[:, 1] / c, color="C0", lw=0.8)
         ax[0].axhline(1.0, color="0.4", ls="--", lw=0.8)
         ax[0].axhline(-1.0, color="0.4", ls="--", lw=0.8)
-        ax[0].set_ylabel("across / c")
+        ax[0].set_ylabel(f"across / c\n(c = {format_quantity(c, 'm')})")
     else:
         ax[0].plot(t, sr.position[:, 1] * 1e3, color="C0", lw=0.8)
         ax[0].set_ylabel("across [mm]")
@@ -68,7 +68,7 @@ def plot_slider(result: SimulationResult, joint: str, *, path: str | Path | None
         ax[1].plot(t, sr.tilt / tilt_max, color="C1", lw=0.8)
         ax[1].axhline(1.0, color="0.4", ls="--", lw=0.8)
         ax[1].axhline(-1.0, color="0.4", ls="--", lw=0.8)
-        ax[1].set_ylabel("tilt / largest")
+        ax[1].set_ylabel(f"tilt / guide's limit\n({format_quantity(tilt_max, 'rad')})")
     else:
         ax[1].plot(t, sr.tilt * 1e3, color="C1", lw=0.8)
         ax[1].set_ylabel("tilt [mrad]")
